@@ -1,0 +1,40 @@
+# Helpers that give every liftoff target the same shape.
+
+# Warnings on, clean: -Wall -Wextra -Wpedantic (and -Werror with LIFTOFF_WERROR).
+function(liftoff_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
+    -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Woverloaded-virtual
+    -Wconversion -Wsign-conversion -Wnull-dereference -Wdouble-promotion)
+  if(LIFTOFF_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(LIFTOFF_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# liftoff_add_module(NAME SOURCES ... DEPS ... PRIVATE_DEPS ...)
+# Makes the library liftoff_<name> with the alias liftoff::<name>.
+function(liftoff_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(liftoff_${name} ${ARG_SOURCES})
+  add_library(liftoff::${name} ALIAS liftoff_${name})
+  target_include_directories(liftoff_${name} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>
+    PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
+  target_link_libraries(liftoff_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  liftoff_set_warnings(liftoff_${name})
+endfunction()
+
+# liftoff_add_test(NAME SOURCES ... DEPS ...): one GoogleTest executable per module.
+function(liftoff_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name}_test ${ARG_SOURCES})
+  target_link_libraries(${name}_test PRIVATE ${ARG_DEPS} liftoff_test_support GTest::gtest_main GTest::gmock)
+  liftoff_set_warnings(${name}_test)
+  gtest_discover_tests(${name}_test
+    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,20 @@
+// One entry point for reading a trial's controller log, whatever its format.
+#pragma once
+
+#include <filesystem>
+
+#include "liftoff/core/calibration.h"
+#include "liftoff/core/controller_log.h"
+#include "liftoff/core/manifest.h"
+#include "liftoff/core/status.h"
+
+namespace liftoff::capture {
+
+/// Reads `path` as `format` (liftoff's own format or an importable older one). Angles
+/// missing from the file but derivable from raw counts or shaft angles are filled in
+/// through `calibration` (a liftoff log that carries counts but no vertebra angle, say).
+Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFormat format,
+                                        const Calibration& calibration,
+                                        const LogReadOptions& options = {});
+
+}  // namespace liftoff::capture

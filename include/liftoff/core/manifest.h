@@ -1,0 +1,104 @@
+// The trial manifest: one JSON file that lists a set of trials, each with its foot, the
+// cable group pulled and rotation direction, its controller log, optional video, optional
+// hand-measured event times and regions of interest. Paths inside are relative to the
+// manifest's folder. Format: docs/formats.md, "trial manifest".
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "liftoff/core/robot.h"
+#include "liftoff/core/status.h"
+
+namespace liftoff {
+
+/// File formats a trial's controller log may be in.
+enum class LogFormat {
+  kLiftoff,    ///< liftoff's own log (docs/formats.md)
+  kLaika2018,  ///< the 2018 Laika serial dump: `t_ms,value,` lines, CR line ends
+};
+
+/// "liftoff", "laika-2018".
+std::string_view LogFormatName(LogFormat format);
+std::optional<LogFormat> ParseLogFormat(std::string_view text);
+
+/// The two instants of a trial on the video's clock, with their timing uncertainty.
+struct EventTimes {
+  /// Video time at which the LED switched on, ns from the video's start.
+  int64_t led_on_ns = 0;
+  /// Video time at which the foot left the ground, ns from the video's start.
+  int64_t liftoff_ns = 0;
+  /// Half-width of the uncertainty of led_on_ns, ns (>= 0).
+  int64_t led_on_uncertainty_ns = 0;
+  /// Half-width of the uncertainty of liftoff_ns, ns (>= 0).
+  int64_t liftoff_uncertainty_ns = 0;
+  /// Who measured them: "hand", "video", "synthetic".
+  std::string source = "hand";
+};
+
+/// A rectangle in video pixels.
+struct RegionPx {
+  int x_px = 0;
+  int y_px = 0;
+  int width_px = 0;
+  int height_px = 0;
+};
+
+struct TrialRecord {
+  /// Unique within the manifest, e.g. "A1".
+  std::string id;
+  /// Foot expected to lift.
+  Foot foot = Foot::kA;
+  /// Test number within the foot's series (1-based), when known.
+  std::optional<int> test_number;
+  /// Horizontal cable group shortened to bend the spine (HR or HL), when known.
+  std::optional<CableGroup> pulled_group;
+  /// Direction of the rotating vertebra's ramp, when known.
+  std::optional<RotationSense> rotation;
+  /// Controller log, absolute (resolved against the manifest's folder when loaded).
+  std::filesystem::path log_path;
+  LogFormat log_format = LogFormat::kLiftoff;
+  /// Video of the trial, absolute, when there is one.
+  std::optional<std::filesystem::path> video_path;
+  /// Event times read by hand (or by any tool outside liftoff), when given.
+  std::optional<EventTimes> times;
+  /// Where the LED and the foot are in the video, when given.
+  std::optional<RegionPx> led_roi_px;
+  std::optional<RegionPx> foot_roi_px;
+  /// Free text.
+  std::string notes;
+};
+
+struct TrialManifest {
+  /// File it was loaded from (empty when built in code).
+  std::filesystem::path source_path;
+  /// Folder relative paths are resolved against.
+  std::filesystem::path base_dir;
+  /// One line for people.
+  std::string description;
+  /// Calibration named by the manifest, absolute, when it names one.
+  std::optional<std::filesystem::path> calibration_path;
+  std::vector<TrialRecord> trials;
+
+  /// Unique ids, known formats, non-negative uncertainties, liftoff after LED on.
+  Status Validate() const;
+};
+
+/// Loads a manifest. Every error names the file and the JSON path of the bad field
+/// ("trials.json: /trials/3/foot: expected one of A, B, C, D, got \"E\""). Paths are
+/// resolved against the manifest's folder; missing log files are not checked here.
+Result<TrialManifest> LoadManifest(const std::filesystem::path& path);
+/// The same from parsed JSON; `source` names it in errors, `base_dir` resolves paths.
+Result<TrialManifest> ManifestFromJson(const nlohmann::json& document, const std::string& source,
+                                       const std::filesystem::path& base_dir);
+/// The manifest as JSON, with paths written relative to `base_dir` where possible.
+nlohmann::json ManifestToJson(const TrialManifest& manifest, const std::filesystem::path& base_dir);
+/// Writes the manifest to `path`, paths relative to the file's folder.
+Status WriteManifest(const std::filesystem::path& path, const TrialManifest& manifest);
+
+}  // namespace liftoff

@@ -1,0 +1,42 @@
+// Vocabulary of the robot under test: its feet, its horizontal cable groups and the
+// rotating vertebra's direction.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace liftoff {
+
+/// Laika's feet. A front right, B front left, C back right, D back left.
+enum class Foot { kA = 0, kB = 1, kC = 2, kD = 3 };
+
+inline constexpr std::array<Foot, 4> kAllFeet = {Foot::kA, Foot::kB, Foot::kC, Foot::kD};
+
+/// "A", "B", "C", "D".
+std::string_view FootName(Foot foot);
+/// "front right", "front left", "back right", "back left".
+std::string_view FootPosition(Foot foot);
+/// Colour of the foot's tape on the hardware: "blue", "orange", "purple", "red".
+std::string_view FootTapeColour(Foot foot);
+/// Parses "A".."D" (exact, upper case); nullopt otherwise.
+std::optional<Foot> ParseFoot(std::string_view text);
+
+/// The four horizontal cable groups (one cable in each of the four gaps between
+/// consecutive vertebrae): top, bottom, right, left. A foot-lifting test pulls HR or HL.
+enum class CableGroup { kHT = 0, kHB = 1, kHR = 2, kHL = 3 };
+
+/// "HT", "HB", "HR", "HL".
+std::string_view CableGroupName(CableGroup group);
+std::optional<CableGroup> ParseCableGroup(std::string_view text);
+
+/// Direction of the rotating vertebra's ramp: +1 or -1 (sign of the commanded angle).
+enum class RotationSense { kPositive = 1, kNegative = -1 };
+
+/// "+" or "-".
+std::string_view RotationSenseName(RotationSense sense);
+/// Parses "+" or "-".
+std::optional<RotationSense> ParseRotationSense(std::string_view text);
+
+}  // namespace liftoff

@@ -1,0 +1,53 @@
+#include "support/test_support.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace liftoff::testing {
+
+std::filesystem::path SourceDir() {
+  if (const char* env = std::getenv("LIFTOFF_SOURCE_DIR")) return env;
+  return LIFTOFF_SOURCE_DIR;
+}
+
+std::optional<std::filesystem::path> ReferenceDir() {
+  std::filesystem::path dir;
+  if (const char* env = std::getenv("LIFTOFF_REFERENCE_DIR")) {
+    dir = env;
+  } else {
+    dir = SourceDir().parent_path() / "shared" / "reference";
+  }
+  if (!std::filesystem::is_directory(dir / "laika-2018-hardware")) return std::nullopt;
+  return dir;
+}
+
+ScratchDir::ScratchDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "test";
+  std::random_device random;
+  path_ = std::filesystem::temp_directory_path() /
+          ("liftoff-" + name + "-" + std::to_string(random()));
+  std::filesystem::create_directories(path_);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
+void WriteFile(const std::filesystem::path& path, const std::string& contents) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << contents;
+}
+
+std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  return contents.str();
+}
+
+}  // namespace liftoff::testing
