@@ -1,1 +1,337 @@
-// placeholder: being written
+#include "liftoff/cli/commands.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/capture/laika2018.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/time.h"
+#include "liftoff/stats/sim_results.h"
+#include "liftoff/stats/table.h"
+#include "liftoff/sync/trial_analysis.h"
+
+namespace liftoff::cli {
+namespace {
+
+std::string Fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+// Sends finished text to the output file, or to `out` when none is named.
+int Emit(const std::string& text, const std::filesystem::path& output_path, std::ostream& out,
+         std::ostream& err) {
+  if (output_path.empty()) {
+    out << text;
+    return kExitOk;
+  }
+  const Status written = WriteTextFile(output_path, text);
+  if (!written.ok()) return ReportError(written, err);
+  err << "wrote " << output_path.string() << '\n';
+  return kExitOk;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// liftoff table
+
+int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) {
+  // flags
+  const auto format = stats::ParseTableFormat(command.format);
+  if (!format) {
+    return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
+                                            command.format + "\""),
+                       err);
+  }
+  if (command.tables != "both" && command.tables != "trials" && command.tables != "feet") {
+    return ReportError(InvalidArgumentError("--tables: expected both, trials or feet, got \"" +
+                                            command.tables + "\""),
+                       err);
+  }
+  auto lookup = LookupOptionsFrom(command.lookup);
+  if (!lookup.ok()) return ReportError(lookup.status(), err);
+
+  // inputs: manifest, calibration, optional simulation results
+  auto manifest = LoadManifest(command.manifest_path);
+  if (!manifest.ok()) return ReportError(manifest.status(), err);
+  auto calibration = ChooseCalibration(command.calibration,
+                                       manifest->calibration_path.value_or(std::filesystem::path()));
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  std::optional<stats::SimResults> sim;
+  if (!command.sim_path.empty()) {
+    auto loaded = stats::LoadSimResults(command.sim_path);
+    if (!loaded.ok()) return ReportError(loaded.status(), err);
+    sim = std::move(loaded).value();
+  }
+
+  // every trial through sync; failures are reported and the rest still tabulated
+  sync::AnalysisOptions options;
+  options.lookup = *lookup;
+  options.log.max_bad_lines = command.lookup.max_bad_lines;
+  const sync::ManifestAnalysis analysis = sync::AnalyzeManifest(*manifest, *calibration, options);
+  Status first_failure;
+  for (const sync::TrialOutcome& outcome : analysis.outcomes) {
+    PrintLogWarnings(outcome.log_report, err);
+    if (!outcome.status.ok()) {
+      err << "error: " << outcome.status.ToString() << '\n';
+      if (first_failure.ok()) first_failure = outcome.status;
+      continue;
+    }
+    for (const std::string& warning : outcome.measurement->lookup.warnings) {
+      err << "note: " << outcome.trial.id << ": " << warning << '\n';
+    }
+  }
+
+  // tables
+  const std::vector<stats::TrialValue> values = analysis.Values();
+  const std::string rule_name(sync::LookupRuleName(analysis.rule));
+  const stats::ResultsTable table = stats::BuildResultsTable(
+      values, sim ? &*sim : nullptr, analysis.calibration, rule_name);
+  std::string text;
+  if (command.tables == "trials") {
+    text = stats::RenderTrialTable(values, *format, analysis.calibration, rule_name);
+  } else if (command.tables == "feet" || *format == stats::TableFormat::kJson) {
+    text = stats::RenderResultsTable(table, *format);  // JSON holds the trials too
+  } else {
+    text = stats::RenderTrialTable(values, *format, analysis.calibration, rule_name) + "\n" +
+           stats::RenderResultsTable(table, *format);
+  }
+  const int emitted = Emit(text, command.output_path, out, err);
+  if (emitted != kExitOk) return emitted;
+
+  if (!first_failure.ok()) {
+    err << "liftoff: " << analysis.failed << " of " << analysis.outcomes.size()
+        << " trials failed; the table holds the others\n";
+    return ExitCodeFor(first_failure.code());
+  }
+  return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff import-2018
+
+int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostream& err) {
+  if (command.output_path.empty()) {
+    return ReportError(InvalidArgumentError("--output: name the manifest file to write"), err);
+  }
+  if (std::filesystem::exists(command.output_path) && !command.force) {
+    return ReportError(InvalidArgumentError(command.output_path.string() +
+                                            ": exists; pass --force to overwrite it"),
+                       err);
+  }
+  auto imported = capture::ImportLaika2018Folder(command.folder, command.output_path);
+  if (!imported.ok()) return ReportError(imported.status(), err);
+  for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
+  const Status written = WriteManifest(command.output_path, imported->manifest);
+  if (!written.ok()) return ReportError(written, err);
+  out << "wrote " << command.output_path.string() << ": " << imported->manifest.trials.size()
+      << " trials from " << command.folder.string() << '\n';
+  return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff sync
+
+int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
+  auto lookup = LookupOptionsFrom(command.lookup);
+  if (!lookup.ok()) return ReportError(lookup.status(), err);
+  if (!(command.uncertainty_s >= 0.0)) {
+    return ReportError(InvalidArgumentError("--uncertainty: expected seconds >= 0, got " +
+                                            Fixed(command.uncertainty_s, 6)),
+                       err);
+  }
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  LogReadOptions read_options;
+  read_options.max_bad_lines = command.lookup.max_bad_lines;
+  auto log = LoadLogByName(command.log_path, command.log_format, *calibration, read_options);
+  if (!log.ok()) return ReportError(log.status(), err);
+  PrintLogWarnings(log->report, err);
+
+  EventTimes times;
+  times.led_on_ns = NsFromSeconds(command.led_on_s);
+  times.liftoff_ns = NsFromSeconds(command.liftoff_s);
+  times.led_on_uncertainty_ns = NsFromSeconds(command.uncertainty_s);
+  times.liftoff_uncertainty_ns = times.led_on_uncertainty_ns;
+  times.source = "command line";
+  auto measured = sync::MeasureLiftoff(*log, times, *lookup);
+  if (!measured.ok()) {
+    return ReportError(measured.status().WithContext(command.log_path.filename().string()), err);
+  }
+
+  const sync::AngleLookup& at = measured->lookup;
+  if (command.json) {
+    nlohmann::json document = {
+        {"log", command.log_path.string()},
+        {"calibration", calibration->Brief()},
+        {"rule", sync::LookupRuleName(lookup->rule)},
+        {"interval_s", SecondsFromNs(measured->interval_ns)},
+        {"interval_uncertainty_s", SecondsFromNs(measured->interval_uncertainty_ns)},
+        {"liftoff_log_s", SecondsFromNs(measured->liftoff_log_ns)},
+        {"vertebra_rad", at.vertebra_rad},
+        {"liftoff_rad", measured->liftoff_rad},
+        {"lower_rad", measured->lower_rad},
+        {"upper_rad", measured->upper_rad},
+        {"in_gap", at.in_gap},
+        {"past_end", at.past_end},
+        {"warnings", at.warnings},
+    };
+    out << document.dump(2) << '\n';
+    return kExitOk;
+  }
+  out << "calibration: " << calibration->Brief() << "; rule: " << sync::LookupRuleName(lookup->rule)
+      << '\n'
+      << "interval LED on -> liftoff: " << FormatSeconds(measured->interval_ns, 3) << " s +- "
+      << FormatSeconds(measured->interval_uncertainty_ns, 3) << " s\n"
+      << "log instant: " << FormatSeconds(measured->liftoff_log_ns, 3) << " s\n"
+      << "vertebra angle: " << Fixed(at.vertebra_rad, 4) << " rad; at liftoff |angle| "
+      << Fixed(measured->liftoff_rad, 4) << " rad in [" << Fixed(measured->lower_rad, 4) << ", "
+      << Fixed(measured->upper_rad, 4) << "]\n";
+  for (const std::string& warning : at.warnings) out << "note: " << warning << '\n';
+  return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff log
+
+int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
+  if (!(command.gap_threshold_s > 0.0)) {
+    return ReportError(InvalidArgumentError("--gap-threshold: expected seconds > 0"), err);
+  }
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  LogReadOptions read_options;
+  read_options.max_bad_lines = command.max_bad_lines;
+  auto log = LoadLogByName(command.log_path, command.log_format, *calibration, read_options);
+  if (!log.ok()) return ReportError(log.status(), err);
+  PrintLogWarnings(log->report, err);
+
+  // span, rate and gaps of the sample stream
+  const std::vector<LogSample>& samples = log->samples;
+  const int64_t gap_threshold_ns = NsFromSeconds(command.gap_threshold_s);
+  int64_t gaps = 0;
+  int64_t longest_gap_ns = 0;
+  int64_t longest_gap_at_ns = 0;
+  for (size_t i = 1; i < samples.size(); ++i) {
+    const int64_t step = samples[i].device_time_ns - samples[i - 1].device_time_ns;
+    if (step > gap_threshold_ns) ++gaps;
+    if (step > longest_gap_ns) {
+      longest_gap_ns = step;
+      longest_gap_at_ns = samples[i - 1].device_time_ns;
+    }
+  }
+  const int64_t span_ns = log->LastSampleNs() - log->FirstSampleNs();
+  const double rate_hz =
+      span_ns > 0 ? static_cast<double>(samples.size() - 1) / SecondsFromNs(span_ns) : 0.0;
+  const std::optional<int64_t> led_ns = log->LedOnTimeNs();
+  double min_angle = INFINITY, max_angle = -INFINITY;
+  for (const LogSample& sample : samples) {
+    if (std::isnan(sample.vertebra_rad)) continue;
+    min_angle = std::min(min_angle, sample.vertebra_rad);
+    max_angle = std::max(max_angle, sample.vertebra_rad);
+  }
+
+  if (command.json) {
+    nlohmann::json document = {
+        {"log", command.log_path.string()},
+        {"format", log->report.format},
+        {"calibration", log->header.calibration},
+        {"samples", samples.size()},
+        {"events", log->events.size()},
+        {"first_sample_s", SecondsFromNs(log->FirstSampleNs())},
+        {"last_sample_s", SecondsFromNs(log->LastSampleNs())},
+        {"mean_rate_hz", rate_hz},
+        {"gaps", gaps},
+        {"gap_threshold_s", command.gap_threshold_s},
+        {"longest_gap_s", SecondsFromNs(longest_gap_ns)},
+        {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
+        {"vertebra_min_rad", std::isfinite(min_angle) ? nlohmann::json(min_angle) : nlohmann::json()},
+        {"vertebra_max_rad", std::isfinite(max_angle) ? nlohmann::json(max_angle) : nlohmann::json()},
+        {"bad_lines", log->report.bad_lines},
+        {"truncated_last_line", log->report.truncated_last_line},
+    };
+    out << document.dump(2) << '\n';
+  } else {
+    out << command.log_path.string() << " (" << log->report.format << ")\n"
+        << "  samples: " << samples.size() << ", events: " << log->events.size()
+        << ", bad lines: " << log->report.bad_lines
+        << (log->report.truncated_last_line ? " (last line truncated)" : "") << '\n'
+        << "  device time: " << FormatSeconds(log->FirstSampleNs()) << " .. "
+        << FormatSeconds(log->LastSampleNs()) << " s, mean rate " << Fixed(rate_hz, 1) << " Hz\n"
+        << "  gaps longer than " << Fixed(command.gap_threshold_s, 3) << " s: " << gaps;
+    if (longest_gap_ns > 0) {
+      out << " (longest " << FormatSeconds(longest_gap_ns) << " s after "
+          << FormatSeconds(longest_gap_at_ns) << " s)";
+    }
+    out << '\n'
+        << "  LED on: " << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)")
+        << '\n';
+    if (std::isfinite(min_angle)) {
+      out << "  vertebra angle: " << Fixed(min_angle, 4) << " .. " << Fixed(max_angle, 4)
+          << " rad (calibration " << calibration->Brief() << ")\n";
+    }
+  }
+
+  if (!command.convert_path.empty()) {
+    const Status written = WriteControllerLog(command.convert_path, *log);
+    if (!written.ok()) return ReportError(written, err);
+    err << "wrote " << command.convert_path.string() << '\n';
+  }
+  return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff calib
+
+int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err) {
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  const Calibration& c = *calibration;
+  if (command.json) {
+    out << CalibrationToJson(c).dump(2) << '\n';
+    return kExitOk;
+  }
+  const double counts_per_shaft_rev = c.encoder_counts_per_motor_rev * c.gearbox_ratio;
+  out << "calibration: " << c.Brief() << '\n';
+  if (!c.description.empty()) out << "  " << c.description << '\n';
+  out << "rotating vertebra: " << Fixed(c.encoder_counts_per_motor_rev, 0)
+      << " counts/motor rev x " << Fixed(c.gearbox_ratio, 0) << ":1 gearbox x "
+      << Fixed(c.spur_gear_ratio, 2) << ":1 spur gear\n"
+      << "  " << Fixed(counts_per_shaft_rev, 0) << " counts per output-shaft revolution, "
+      << Fixed(counts_per_shaft_rev * c.spur_gear_ratio, 0) << " per vertebra revolution\n"
+      << "  one count = " << Fixed(c.VertebraAngleFromCounts(1) * 1e6, 1)
+      << " microrad of vertebra rotation\n"
+      << "bending spool grooves (m):";
+  for (double radius : c.spool_groove_radii_m) out << ' ' << Fixed(radius, 4);
+  out << "; cable lengths (m):";
+  for (double length : c.cable_lengths_m) out << ' ' << Fixed(length, 4);
+  const auto percent = c.PercentLengthChangeFromSpoolAngle(1.0);
+  out << "\n  percent length change per spool radian:";
+  for (double p : percent) out << ' ' << Fixed(p, 2);
+  out << "\nmaterials (N/m):";
+  for (const MaterialConstant& m : c.materials) {
+    out << ' ' << m.name << ' ' << Fixed(m.stiffness_n_per_m, 0) << " +- "
+        << Fixed(m.stiffness_stddev_n_per_m, 0) << ';';
+  }
+  out << "\ntension points (silicone / Buna-N / spring, N/m):\n";
+  for (const TensionPoint& p : c.tension_points) {
+    out << "  " << p.name << " (" << (p.sigma >= 0 ? "+" : "") << Fixed(p.sigma, 0)
+        << " sigma): " << Fixed(p.silicone_n_per_m, 0) << " / " << Fixed(p.buna_n_n_per_m, 0)
+        << " / " << Fixed(p.spring_n_per_m, 0) << '\n';
+  }
+  if (!c.notes.empty()) {
+    out << "provenance:\n";
+    for (const auto& [field, note] : c.notes) out << "  " << field << ": " << note << '\n';
+  }
+  return kExitOk;
+}
+
+}  // namespace liftoff::cli

@@ -39,6 +39,12 @@ std::string DescribeRange(const NumberRange& range, bool integer) {
   return what;
 }
 
+bool InRange(double value, const NumberRange& range) {
+  const bool below = range.min_exclusive ? !(value > range.min) : !(value >= range.min);
+  const bool above = range.max_exclusive ? !(value < range.max) : !(value <= range.max);
+  return !(below || above || std::isnan(value));
+}
+
 // Line and column of a byte offset, both from 1.
 std::pair<size_t, size_t> LineColumn(std::string_view text, size_t offset) {
   size_t line = 1, column = 1;
@@ -132,9 +138,8 @@ struct JsonReader::Shared {
 };
 
 JsonReader::JsonReader(const json& value, std::string source)
-    : JsonReader(&value, "", std::make_shared<Shared>()) {
-  shared_->source = std::move(source);
-}
+    // the source is set before the delegated constructor can report a non-object
+    : JsonReader(&value, "", std::make_shared<Shared>(Shared{std::move(source), Status(), {}})) {}
 
 JsonReader::JsonReader(const json* value, std::string pointer, std::shared_ptr<Shared> shared)
     : value_(value), pointer_(std::move(pointer)), shared_(std::move(shared)) {
@@ -183,9 +188,7 @@ const json* JsonReader::Raw(std::string_view key) { return Find(key, true); }
 
 bool JsonReader::CheckRange(std::string_view key, double value, const NumberRange& range,
                             bool integer) {
-  const bool below = range.min_exclusive ? !(value > range.min) : !(value >= range.min);
-  const bool above = range.max_exclusive ? !(value < range.max) : !(value <= range.max);
-  if (below || above || std::isnan(value)) {
+  if (!InRange(value, range)) {
     Fail(key, "expected " + DescribeRange(range, integer) + ", got " + FormatNumber(value));
     return false;
   }
@@ -290,13 +293,22 @@ std::optional<std::vector<double>> JsonReader::OptionalNumberArray(std::string_v
   std::vector<double> numbers;
   for (size_t i = 0; i < value->size(); ++i) {
     const json& element = (*value)[i];
-    const std::string element_key = std::string(key) + "/" + std::to_string(i);
+    // the index is a pointer step of its own, not part of an escaped key
+    const auto fail_element = [&](const std::string& got) {
+      if (!shared_->first_error.ok()) return;
+      shared_->first_error = InvalidArgumentError(
+          shared_->source + ": " + ChildPointer(key) + "/" + std::to_string(i) + ": expected " +
+          DescribeRange(range, false) + ", got " + got);
+    };
     if (!element.is_number()) {
-      Fail(element_key, "expected " + DescribeRange(range, false) + ", got " + Describe(element));
+      fail_element(Describe(element));
       return std::nullopt;
     }
     numbers.push_back(element.get<double>());
-    if (!CheckRange(element_key, numbers.back(), range, false)) return std::nullopt;
+    if (!InRange(numbers.back(), range)) {
+      fail_element(FormatNumber(numbers.back()));
+      return std::nullopt;
+    }
   }
   return numbers;
 }

@@ -21,8 +21,15 @@ Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns) {
   size_t i = 0;
   bool negative = false;
   if (i < text.size() && (text[i] == '+' || text[i] == '-')) negative = text[i++] == '-';
-  // integer part and fraction, as one integer of digits plus a count of fraction digits
-  Int128 mantissa = 0;
+  // integer part and fraction apart; 19 fraction digits resolve 1 ns of any unit up to
+  // 1e18 ns and decide its rounding, so later digits are checked but not used
+  constexpr int kMaxFractionDigits = 19;
+  constexpr Int128 kInt64Max = std::numeric_limits<int64_t>::max();
+  const auto too_large = [&] {
+    return OutOfRangeError("\"" + std::string(text) + "\" is too large a time");
+  };
+  Int128 whole = 0;
+  Int128 fraction = 0;
   int fraction_digits = 0;
   bool seen_digit = false;
   bool seen_point = false;
@@ -34,22 +41,22 @@ Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns) {
     }
     if (c < '0' || c > '9') return bad();
     seen_digit = true;
-    if (mantissa > (static_cast<Int128>(1) << 100)) {
-      if (!seen_point) return OutOfRangeError("\"" + std::string(text) + "\" is too large a time");
-      continue;  // sub-attosecond digits cannot change the rounded result
+    if (!seen_point) {
+      whole = whole * 10 + (c - '0');
+      if (whole > kInt64Max) return too_large();  // unit_ns >= 1: already too many ns
+    } else if (fraction_digits < kMaxFractionDigits) {
+      fraction = fraction * 10 + (c - '0');
+      ++fraction_digits;
     }
-    mantissa = mantissa * 10 + (c - '0');
-    if (seen_point) ++fraction_digits;
   }
   if (!seen_digit) return bad();
-  // scale to nanoseconds: mantissa * unit_ns / 10^fraction_digits, rounded half away
-  Int128 numerator = mantissa * unit_ns;
+  // scale to nanoseconds: whole * unit_ns + fraction * unit_ns / 10^digits, rounded half
+  // away from zero (every product stays below 2^127)
   Int128 denominator = 1;
   for (int d = 0; d < fraction_digits; ++d) denominator *= 10;
-  Int128 ns = (numerator + denominator / 2) / denominator;
-  if (ns > std::numeric_limits<int64_t>::max()) {
-    return OutOfRangeError("\"" + std::string(text) + "\" is too large a time");
-  }
+  const Int128 ns = whole * unit_ns + (fraction * unit_ns + denominator / 2) / denominator;
+  // the negative side holds one more nanosecond than the positive
+  if (ns > kInt64Max + (negative ? 1 : 0)) return too_large();
   return static_cast<int64_t>(negative ? -ns : ns);
 }
 

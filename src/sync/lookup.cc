@@ -1,1 +1,273 @@
-// placeholder: being written
+#include "liftoff/sync/lookup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace liftoff::sync {
+namespace {
+
+// a sample that carries a vertebra angle
+struct AnglePoint {
+  int64_t time_ns;
+  double vertebra_rad;
+};
+
+std::string Rad(double value_rad) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.4f", value_rad);
+  return buffer;
+}
+
+std::string Sec(int64_t ns) { return FormatSeconds(ns, 3) + " s"; }
+
+// the angle at `time_ns` under `rule`, holding the end values outside the log
+double AngleAt(const std::vector<AnglePoint>& points, int64_t time_ns, LookupRule rule) {
+  if (time_ns <= points.front().time_ns) return points.front().vertebra_rad;
+  if (time_ns >= points.back().time_ns) return points.back().vertebra_rad;
+  const auto after = std::upper_bound(
+      points.begin(), points.end(), time_ns,
+      [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
+  const AnglePoint& before = *(after - 1);
+  if (rule == LookupRule::kSampleAndHold || before.time_ns == time_ns) return before.vertebra_rad;
+  const double fraction = static_cast<double>(time_ns - before.time_ns) /
+                          static_cast<double>(after->time_ns - before.time_ns);
+  return before.vertebra_rad + fraction * (after->vertebra_rad - before.vertebra_rad);
+}
+
+}  // namespace
+
+std::string_view LookupRuleName(LookupRule rule) {
+  switch (rule) {
+    case LookupRule::kLinear: return "linear";
+    case LookupRule::kSampleAndHold: return "sample-and-hold";
+  }
+  return "unknown";
+}
+
+std::optional<LookupRule> ParseLookupRule(std::string_view text) {
+  if (text == "linear") return LookupRule::kLinear;
+  if (text == "hold" || text == "sample-and-hold") return LookupRule::kSampleAndHold;
+  return std::nullopt;
+}
+
+Status LookupOptions::Validate() const {
+  if (!std::isfinite(gap_threshold_s) || gap_threshold_s <= 0.0) {
+    return InvalidArgumentError("lookup options: gap_threshold_s: expected a number > 0 s, got " +
+                                std::to_string(gap_threshold_s));
+  }
+  if (!std::isfinite(max_past_end_s) || max_past_end_s < 0.0) {
+    return InvalidArgumentError("lookup options: max_past_end_s: expected a number >= 0 s, got " +
+                                std::to_string(max_past_end_s));
+  }
+  return Status::Ok();
+}
+
+std::string AngleLookup::Brief() const {
+  std::string text = Rad(vertebra_rad) + " rad [" + Rad(lower_rad) + ", " + Rad(upper_rad) +
+                     "] at " + FormatSeconds(query_ns) + " +/- " +
+                     FormatSeconds(query_uncertainty_ns) + " s (" +
+                     std::string(LookupRuleName(rule));
+  if (in_gap) text += "; in a " + FormatSeconds(gap_ns, 2) + " s gap";
+  if (past_end) text += "; past the log's end";
+  if (before_start) text += "; before the log's start";
+  return text + ")";
+}
+
+Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_ns,
+                                        int64_t query_uncertainty_ns,
+                                        const LookupOptions& options) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  if (query_uncertainty_ns < 0) {
+    return InvalidArgumentError("query uncertainty: expected >= 0 ns, got " +
+                                std::to_string(query_uncertainty_ns));
+  }
+
+  // the samples that carry an angle
+  std::vector<AnglePoint> points;
+  points.reserve(log.samples.size());
+  for (const LogSample& sample : log.samples) {
+    if (std::isnan(sample.vertebra_rad)) continue;
+    points.push_back({sample.device_time_ns, sample.vertebra_rad});
+  }
+  if (log.samples.empty()) return NotFoundError("the log has no samples");
+  if (points.empty()) {
+    return NotFoundError("none of the log's " + std::to_string(log.samples.size()) +
+                         " samples has a vertebra angle");
+  }
+  const AnglePoint& first = points.front();
+  const AnglePoint& last = points.back();
+  const std::string span = "(log spans " + FormatSeconds(first.time_ns) + "-" +
+                           FormatSeconds(last.time_ns) + " s)";
+
+  // queries too far outside the log
+  const int64_t tolerance_ns = NsFromSeconds(options.max_past_end_s);
+  const std::string limit = "; at most max_past_end_s = " + FormatSeconds(tolerance_ns) +
+                            " s outside the log is answered";
+  if (query_ns > last.time_ns && query_ns - last.time_ns > tolerance_ns) {
+    return OutOfRangeError("instant " + Sec(query_ns) + " is after the log's last sample at " +
+                           Sec(last.time_ns) + " " + span + limit);
+  }
+  if (query_ns < first.time_ns && first.time_ns - query_ns > tolerance_ns) {
+    return OutOfRangeError("instant " + Sec(query_ns) + " is before the log's first sample at " +
+                           Sec(first.time_ns) + " " + span + limit);
+  }
+
+  AngleLookup lookup;
+  lookup.rule = options.rule;
+  lookup.query_ns = query_ns;
+  lookup.query_uncertainty_ns = query_uncertainty_ns;
+  lookup.vertebra_rad = AngleAt(points, query_ns, options.rule);
+
+  // bracketing samples: last at or before, first at or after
+  const auto at_or_after = std::lower_bound(
+      points.begin(), points.end(), query_ns,
+      [](const AnglePoint& point, int64_t t) { return point.time_ns < t; });
+  if (at_or_after != points.end()) lookup.sample_after_ns = at_or_after->time_ns;
+  if (at_or_after != points.end() && at_or_after->time_ns == query_ns) {
+    lookup.sample_before_ns = query_ns;
+  } else if (at_or_after != points.begin()) {
+    lookup.sample_before_ns = (at_or_after - 1)->time_ns;
+  }
+
+  // range of the rule's answer over the window: its ends and every sample inside
+  const int64_t window_begin_ns = query_ns - query_uncertainty_ns;
+  const int64_t window_end_ns = query_ns + query_uncertainty_ns;
+  double lower = std::min(AngleAt(points, window_begin_ns, options.rule),
+                          AngleAt(points, window_end_ns, options.rule));
+  double upper = std::max(AngleAt(points, window_begin_ns, options.rule),
+                          AngleAt(points, window_end_ns, options.rule));
+  lower = std::min(lower, lookup.vertebra_rad);
+  upper = std::max(upper, lookup.vertebra_rad);
+  const auto inside_begin = std::upper_bound(
+      points.begin(), points.end(), window_begin_ns,
+      [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
+  auto inside_end = inside_begin;
+  for (; inside_end != points.end() && inside_end->time_ns < window_end_ns; ++inside_end) {
+    lower = std::min(lower, inside_end->vertebra_rad);
+    upper = std::max(upper, inside_end->vertebra_rad);
+  }
+
+  // gaps the window overlaps: the angle there is only known to lie between their ends
+  const int64_t gap_threshold_ns = NsFromSeconds(options.gap_threshold_s);
+  const auto scan_begin = inside_begin == points.begin() ? inside_begin : inside_begin - 1;
+  const auto scan_end = inside_end == points.end() ? inside_end : inside_end + 1;
+  const AnglePoint* gap_before = nullptr;  // the reported gap
+  bool query_in_reported_gap = false;
+  for (auto it = scan_begin; it != scan_end && it + 1 != points.end(); ++it) {
+    const AnglePoint& before = *it;
+    const AnglePoint& after = *(it + 1);
+    const int64_t gap_ns = after.time_ns - before.time_ns;
+    if (gap_ns <= gap_threshold_ns) continue;
+    if (before.time_ns >= window_end_ns || after.time_ns <= window_begin_ns) continue;
+    lower = std::min({lower, before.vertebra_rad, after.vertebra_rad});
+    upper = std::max({upper, before.vertebra_rad, after.vertebra_rad});
+    const bool holds_query = before.time_ns < query_ns && query_ns < after.time_ns;
+    if (gap_before == nullptr || (holds_query && !query_in_reported_gap) ||
+        (holds_query == query_in_reported_gap && gap_ns > lookup.gap_ns)) {
+      gap_before = &before;
+      lookup.gap_ns = gap_ns;
+      query_in_reported_gap = holds_query;
+    }
+  }
+  if (gap_before != nullptr) {
+    lookup.in_gap = true;
+    const std::string where = "a " + FormatSeconds(lookup.gap_ns, 2) +
+                              " s gap between samples at " + Sec(gap_before->time_ns) + " and " +
+                              Sec(gap_before->time_ns + lookup.gap_ns);
+    lookup.warnings.push_back(
+        query_in_reported_gap
+            ? "instant " + Sec(query_ns) + " is inside " + where
+            : "the window " + FormatSeconds(query_ns) + " +/- " + Sec(query_uncertainty_ns) +
+                  " overlaps " + where);
+  }
+
+  // past either end: widen by the log's mean rate times the distance outside
+  const int64_t span_ns = last.time_ns - first.time_ns;
+  const double mean_rate_rad_per_s =
+      span_ns > 0 ? std::abs(last.vertebra_rad - first.vertebra_rad) / SecondsFromNs(span_ns) : 0.0;
+  const int64_t after_end_ns = std::max<int64_t>(0, window_end_ns - last.time_ns);
+  const int64_t before_start_ns = std::max<int64_t>(0, first.time_ns - window_begin_ns);
+  const double widen_rad = mean_rate_rad_per_s * SecondsFromNs(after_end_ns + before_start_ns);
+  lower -= widen_rad;
+  upper += widen_rad;
+  lookup.past_end = query_ns > last.time_ns;
+  lookup.before_start = query_ns < first.time_ns;
+  if (lookup.past_end) {
+    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " +
+                              Sec(query_ns - last.time_ns) + " after the log's last sample at " +
+                              Sec(last.time_ns) + "; its value is held");
+  } else if (after_end_ns > 0) {
+    lookup.warnings.push_back("the window " + FormatSeconds(query_ns) + " +/- " +
+                              Sec(query_uncertainty_ns) + " reaches " + Sec(after_end_ns) +
+                              " past the log's last sample at " + Sec(last.time_ns));
+  }
+  if (lookup.before_start) {
+    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " +
+                              Sec(first.time_ns - query_ns) +
+                              " before the log's first sample at " + Sec(first.time_ns) +
+                              "; its value is held");
+  } else if (before_start_ns > 0) {
+    lookup.warnings.push_back("the window " + FormatSeconds(query_ns) + " +/- " +
+                              Sec(query_uncertainty_ns) + " reaches " + Sec(before_start_ns) +
+                              " before the log's first sample at " + Sec(first.time_ns));
+  }
+  if (widen_rad > 0.0) {
+    lookup.warnings.back() += "; interval widened by the log's mean rate " +
+                              Rad(mean_rate_rad_per_s) + " rad/s to +/- " + Rad(widen_rad) + " rad";
+  }
+  lookup.lower_rad = lower;
+  lookup.upper_rad = upper;
+  return lookup;
+}
+
+std::string LiftoffMeasurement::Brief() const {
+  std::string text = "liftoff " + Sec(interval_ns) + " after LED on (+/- " +
+                     Sec(interval_uncertainty_ns) + "), " + Sec(liftoff_log_ns) +
+                     " on the log: |vertebra| " + Rad(liftoff_rad) + " rad [" + Rad(lower_rad) +
+                     ", " + Rad(upper_rad) + "] (" + std::string(LookupRuleName(lookup.rule));
+  if (lookup.in_gap) text += "; in a " + FormatSeconds(lookup.gap_ns, 2) + " s gap";
+  if (lookup.past_end) text += "; past the log's end";
+  if (lookup.before_start) text += "; before the log's start";
+  return text + ")";
+}
+
+Result<LiftoffMeasurement> MeasureLiftoff(const ControllerLog& log, const EventTimes& video_times,
+                                          const LookupOptions& options) {
+  // the video's interval, checked
+  if (video_times.led_on_uncertainty_ns < 0 || video_times.liftoff_uncertainty_ns < 0) {
+    return InvalidArgumentError("event times: uncertainties must be >= 0, got LED on +/- " +
+                                Sec(video_times.led_on_uncertainty_ns) + " and liftoff +/- " +
+                                Sec(video_times.liftoff_uncertainty_ns));
+  }
+  if (video_times.liftoff_ns < video_times.led_on_ns) {
+    return InvalidArgumentError("event times: liftoff at " + Sec(video_times.liftoff_ns) +
+                                " is before the LED switched on at " +
+                                Sec(video_times.led_on_ns) + " (video clock)");
+  }
+  LiftoffMeasurement measurement;
+  measurement.interval_ns = video_times.liftoff_ns - video_times.led_on_ns;
+  measurement.interval_uncertainty_ns =
+      video_times.led_on_uncertainty_ns + video_times.liftoff_uncertainty_ns;
+
+  // the video's LED-on is the log's LED-on (the 2018 device clock starts there)
+  measurement.log_from_video.source_origin_ns = video_times.led_on_ns;
+  measurement.log_from_video.target_at_origin_ns = log.LedOnTimeNs().value_or(0);
+  measurement.log_from_video.scale = 1.0;
+  measurement.liftoff_log_ns = measurement.log_from_video(video_times.liftoff_ns);
+
+  // the angle there, as an absolute value
+  LIFTOFF_ASSIGN_OR_RETURN(measurement.lookup,
+                           LookupVertebraAngle(log, measurement.liftoff_log_ns,
+                                               measurement.interval_uncertainty_ns, options));
+  const AngleLookup& lookup = measurement.lookup;
+  measurement.liftoff_rad = std::abs(lookup.vertebra_rad);
+  const bool spans_zero = lookup.lower_rad <= 0.0 && lookup.upper_rad >= 0.0;
+  measurement.lower_rad =
+      spans_zero ? 0.0 : std::min(std::abs(lookup.lower_rad), std::abs(lookup.upper_rad));
+  measurement.upper_rad = std::max(std::abs(lookup.lower_rad), std::abs(lookup.upper_rad));
+  return measurement;
+}
+
+}  // namespace liftoff::sync

@@ -1,1 +1,322 @@
-// placeholder: being written
+// The command line end to end: the sample data's known answers, the 2018 reference
+// values, and every kind of bad input giving a clear message and its own exit code.
+#include <array>
+#include <map>
+#include <sys/wait.h>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "liftoff/cli/commands.h"
+#include "liftoff/core/json.h"
+#include "support/test_support.h"
+
+namespace liftoff::cli {
+namespace {
+
+using ::testing::HasSubstr;
+using liftoff::testing::ReadFile;
+using liftoff::testing::ScratchDir;
+using liftoff::testing::SourceDir;
+using liftoff::testing::WriteFile;
+
+struct CommandRun {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+CommandRun RunTableCommand(const TableCommand& command) {
+  std::ostringstream out, err;
+  CommandRun run;
+  run.code = RunTable(command, out, err);
+  run.out = out.str();
+  run.err = err.str();
+  return run;
+}
+
+// Runs the real binary; stdout and stderr captured separately.
+CommandRun RunBinary(const std::string& arguments, const ScratchDir& scratch) {
+  const std::string out_file = (scratch / "stdout.txt").string();
+  const std::string err_file = (scratch / "stderr.txt").string();
+  const std::string command = std::string("\"") + LIFTOFF_BINARY + "\" " + arguments + " >\"" +
+                              out_file + "\" 2>\"" + err_file + "\"";
+  const int status = std::system(command.c_str());
+  CommandRun run;
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.out = ReadFile(out_file);
+  run.err = ReadFile(err_file);
+  return run;
+}
+
+std::string Quoted(const std::filesystem::path& path) { return "\"" + path.string() + "\""; }
+
+// A manifest with one trial whose log is `log_text` in the 2018 format.
+std::filesystem::path WriteOneTrial(const ScratchDir& scratch, const std::string& log_text,
+                                    double led_on_s, double liftoff_s) {
+  WriteFile(scratch / "trial.txt", log_text);
+  nlohmann::json manifest = {
+      {"format", "liftoff-manifest"},
+      {"version", 1},
+      {"trials",
+       {{{"id", "T1"},
+         {"foot", "A"},
+         {"log", {{"path", "trial.txt"}, {"format", "laika-2018"}}},
+         {"times", {{"led_on_s", led_on_s}, {"liftoff_s", liftoff_s}}}}}}};
+  WriteFile(scratch / "manifest.json", manifest.dump(2));
+  return scratch / "manifest.json";
+}
+
+// A 2018-style ramp: shaft angle = t_s, one sample every 100 ms up to `end_ms`.
+std::string RampLog2018(int end_ms) {
+  std::string text;
+  for (int t_ms = 0; t_ms <= end_ms; t_ms += 100) {
+    text += std::to_string(t_ms) + "," + std::to_string(t_ms / 1000.0) + ",\r";
+  }
+  return text;
+}
+
+TEST(CliTable, SampleTrialsMatchTheirKnownAnswers) {
+  const std::filesystem::path samples = SourceDir() / "samples" / "trials";
+  auto expected = LoadJsonFile(samples / "expected.json");
+  ASSERT_TRUE(expected.ok()) << expected.status().ToString();
+
+  TableCommand command;
+  command.manifest_path = samples / "manifest.json";
+  command.format = "json";
+  const CommandRun run = RunTableCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  const nlohmann::json table = nlohmann::json::parse(run.out);
+
+  // every trial of every foot: the truth lies in the reported interval, and the linear
+  // lookup is within encoder quantisation (dense logs) or the 2018 two-decimal rounding
+  int checked = 0;
+  for (const auto& row : table.at("rows")) {
+    for (const auto& trial : row.at("trials")) {
+      const std::string id = trial.at("trial_id");
+      const double truth = (*expected)["trials"][id]["liftoff_rad"];
+      const double value = trial.at("liftoff_rad");
+      EXPECT_NEAR(value, truth, 2e-3) << id;
+      EXPECT_LE(trial.at("lower_rad").get<double>(), truth + 1e-9) << id;
+      EXPECT_GE(trial.at("upper_rad").get<double>(), truth - 1e-9) << id;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 8);
+}
+
+TEST(CliTable, PrintsBothTablesAndNamesTheCalibration) {
+  TableCommand command;
+  command.manifest_path = SourceDir() / "samples" / "trials" / "manifest.json";
+  const CommandRun run = RunTableCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("laika-2018"));
+  EXPECT_THAT(run.out, HasSubstr("A1"));
+  EXPECT_THAT(run.out, HasSubstr("D2"));
+  // the 2018-format sample trial falls inside a burst gap, and says so
+  EXPECT_THAT(run.err, HasSubstr("D2"));
+  EXPECT_THAT(run.err, HasSubstr("gap"));
+}
+
+TEST(CliTable, MissingManifestNamesTheFile) {
+  TableCommand command;
+  command.manifest_path = "/nonexistent/trials.json";
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kNotFound));
+  EXPECT_THAT(run.err, HasSubstr("/nonexistent/trials.json"));
+}
+
+TEST(CliTable, MalformedManifestFieldNamesTheJsonPath) {
+  ScratchDir scratch;
+  WriteOneTrial(scratch, RampLog2018(5000), 1.0, 3.0);
+  std::string text = ReadFile(scratch / "manifest.json");
+  text.replace(text.find("\"A\""), 3, "\"E\"");
+  WriteFile(scratch / "manifest.json", text);
+  TableCommand command;
+  command.manifest_path = scratch / "manifest.json";
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(run.err, HasSubstr("manifest.json: /trials/0/foot"));
+  EXPECT_THAT(run.err, HasSubstr("\"E\""));
+}
+
+TEST(CliTable, LogWithGarbageLinesNamesTheLine) {
+  ScratchDir scratch;
+  std::string log = RampLog2018(5000);
+  log.insert(log.find("300,"), "12#$garbage\r");  // becomes line 4
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, log, 1.0, 3.0);
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kParse));
+  EXPECT_THAT(run.err, HasSubstr("trial.txt:4"));
+  EXPECT_THAT(run.err, HasSubstr("T1"));
+
+  // tolerated when asked, and still reported with its line number
+  command.lookup.max_bad_lines = 1;
+  const CommandRun lenient = RunTableCommand(command);
+  EXPECT_EQ(lenient.code, kExitOk) << lenient.err;
+  EXPECT_THAT(lenient.err, HasSubstr("trial.txt:4"));
+}
+
+TEST(CliTable, EmptyLogIsAnError) {
+  ScratchDir scratch;
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, "", 1.0, 3.0);
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kParse));
+  EXPECT_THAT(run.err, HasSubstr("trial.txt"));
+  EXPECT_THAT(run.err, HasSubstr("no samples"));
+}
+
+TEST(CliTable, LookupBeyondTheLogsEndIsOutOfRange) {
+  ScratchDir scratch;
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, RampLog2018(2000), 1.0, 9.0);  // needs 8 s
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kOutOfRange));
+  EXPECT_THAT(run.err, HasSubstr("T1"));
+  EXPECT_THAT(run.err, HasSubstr("8.000"));
+}
+
+TEST(CliTable, UnknownCalibrationKeyNamesTheJsonPath) {
+  ScratchDir scratch;
+  auto calibration = LoadJsonFile(SourceDir() / "calib" / "laika-2018.json");
+  ASSERT_TRUE(calibration.ok());
+  (*calibration)["gear_ration"] = 4;
+  WriteFile(scratch / "bad-calib.json", calibration->dump(2));
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, RampLog2018(5000), 1.0, 3.0);
+  command.calibration.calibration_path = scratch / "bad-calib.json";
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(run.err, HasSubstr("bad-calib.json: /gear_ration"));
+  EXPECT_THAT(run.err, HasSubstr("unknown key"));
+}
+
+TEST(CliTable, OneBadTrialDoesNotLoseTheOthers) {
+  ScratchDir scratch;
+  WriteFile(scratch / "good.txt", RampLog2018(5000));
+  nlohmann::json manifest = {
+      {"format", "liftoff-manifest"},
+      {"version", 1},
+      {"trials",
+       {{{"id", "good"}, {"foot", "A"}, {"log", {{"path", "good.txt"}, {"format", "laika-2018"}}},
+         {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}},
+        {{"id", "lost"}, {"foot", "B"}, {"log", {{"path", "missing.txt"}, {"format", "laika-2018"}}},
+         {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}}}}};
+  WriteFile(scratch / "manifest.json", manifest.dump());
+  TableCommand command;
+  command.manifest_path = scratch / "manifest.json";
+  command.format = "csv";
+  command.tables = "trials";
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kNotFound));
+  EXPECT_THAT(run.err, HasSubstr("missing.txt"));
+  EXPECT_THAT(run.out, HasSubstr("good"));
+  EXPECT_THAT(run.out, HasSubstr("0.500"));  // shaft 2 rad at log time 2 s, over the 4:1 spur gear
+}
+
+TEST(CliTable, BadFlagValuesAreRejected) {
+  TableCommand command;
+  command.manifest_path = SourceDir() / "samples" / "trials" / "manifest.json";
+  command.format = "xlsx";
+  EXPECT_EQ(RunTableCommand(command).code, ExitCodeFor(StatusCode::kInvalidArgument));
+  command.format = "md";
+  command.lookup.rule = "nearest";
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(run.err, HasSubstr("--rule"));
+}
+
+TEST(CliBinary, HelpUsageAndSampleRun) {
+  ScratchDir scratch;
+  EXPECT_EQ(RunBinary("--help", scratch).code, 0);
+  EXPECT_EQ(RunBinary("table --no-such-flag x", scratch).code, kExitUsage);
+  EXPECT_EQ(RunBinary("", scratch).code, kExitUsage);
+  const CommandRun run =
+      RunBinary("table " + Quoted(SourceDir() / "samples" / "trials" / "manifest.json"), scratch);
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("laika-2018"));
+  const CommandRun missing = RunBinary("table /nonexistent.json", scratch);
+  EXPECT_EQ(missing.code, 4);
+  EXPECT_THAT(missing.err, HasSubstr("/nonexistent.json"));
+}
+
+TEST(CliBinary, CalibAndLogCommands) {
+  ScratchDir scratch;
+  const CommandRun calib = RunBinary("calib", scratch);
+  EXPECT_EQ(calib.code, 0) << calib.err;
+  EXPECT_THAT(calib.out, HasSubstr("48000 per vertebra revolution"));
+  WriteFile(scratch / "ramp.txt", RampLog2018(3000));
+  const CommandRun log = RunBinary("log " + Quoted(scratch / "ramp.txt") + " --convert " +
+                                Quoted(scratch / "ramp.csv"),
+                            scratch);
+  EXPECT_EQ(log.code, 0) << log.err;
+  EXPECT_THAT(log.out, HasSubstr("samples: 31"));
+  // the converted log reads back as liftoff's format with the same samples
+  const CommandRun again = RunBinary("log " + Quoted(scratch / "ramp.csv"), scratch);
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_THAT(again.out, HasSubstr("(liftoff)"));
+  EXPECT_THAT(again.out, HasSubstr("samples: 31"));
+}
+
+TEST(CliSync, OneLookupHoldVersusLinear) {
+  ScratchDir scratch;
+  WriteFile(scratch / "ramp.txt", RampLog2018(5000));
+  SyncCommand command;
+  command.log_path = scratch / "ramp.txt";
+  command.led_on_s = 1.0;
+  command.liftoff_s = 3.25;  // log instant 2.25 s: shaft 2.25 rad, vertebra 0.5625 rad
+  command.json = true;
+  std::ostringstream out, err;
+  ASSERT_EQ(RunSync(command, out, err), kExitOk) << err.str();
+  const auto linear = nlohmann::json::parse(out.str());
+  EXPECT_NEAR(linear["liftoff_rad"].get<double>(), 2.25 / 4, 1e-9);
+
+  command.lookup.rule = "hold";
+  std::ostringstream out2, err2;
+  ASSERT_EQ(RunSync(command, out2, err2), kExitOk) << err2.str();
+  const auto hold = nlohmann::json::parse(out2.str());
+  EXPECT_NEAR(hold["liftoff_rad"].get<double>(), 2.2 / 4, 1e-9);  // sample at 2.2 s
+}
+
+TEST(CliImport2018, ReferenceDataGivesThePublishedSampleAndHoldValues) {
+  LIFTOFF_REQUIRE_REFERENCE(reference);
+  ScratchDir scratch;
+  const std::filesystem::path manifest = scratch / "laika-2018.json";
+  const CommandRun imported = RunBinary(
+      "import-2018 " + Quoted(reference / "laika-2018-hardware") + " -o " + Quoted(manifest),
+      scratch);
+  ASSERT_EQ(imported.code, 0) << imported.err;
+  EXPECT_THAT(imported.out, HasSubstr("20 trials"));
+
+  const CommandRun table =
+      RunBinary("table " + Quoted(manifest) + " --rule hold --format json", scratch);
+  ASSERT_EQ(table.code, 0) << table.err;
+  const nlohmann::json document = nlohmann::json::parse(table.out);
+  // laika-model.md section 7: the authors' rule on the 20 tests
+  const std::map<std::string, std::array<double, 5>> published = {
+      {"A", {0.460, 0.385, 0.432, 0.502, 0.455}},
+      {"B", {0.560, 0.552, 0.600, 0.557, 0.590}},
+      {"C", {0.525, 0.512, 0.510, 0.540, 0.495}},
+      {"D", {0.422, 0.357, 0.435, 0.407, 0.438}}};
+  int checked = 0;
+  for (const auto& row : document.at("rows")) {
+    const std::string foot = row.at("foot");
+    for (const auto& trial : row.at("trials")) {
+      const std::string id = trial.at("trial_id");
+      const auto test = static_cast<size_t>(id.back() - '0');
+      EXPECT_NEAR(trial.at("liftoff_rad").get<double>(), published.at(foot)[test - 1], 1e-3) << id;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 20);
+  EXPECT_THAT(table.out, HasSubstr("laika-2018"));
+}
+
+}  // namespace
+}  // namespace liftoff::cli

@@ -12,7 +12,10 @@ namespace liftoff::capture {
 
 /// Reads `path` as `format` (liftoff's own format or an importable older one). Angles
 /// missing from the file but derivable from raw counts or shaft angles are filled in
-/// through `calibration` (a liftoff log that carries counts but no vertebra angle, say).
+/// through `calibration` (a liftoff log that carries counts but no vertebra angle, say):
+/// rotate_shaft_rad from rotate_counts, vertebra_rad from rotate_shaft_rad, bend_spool_rad
+/// from bend_counts; angles present in the file are kept. Errors are the reader's, and
+/// always name the file.
 Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFormat format,
                                         const Calibration& calibration,
                                         const LogReadOptions& options = {});

@@ -1,0 +1,108 @@
+// The liftoff command line, one Run<Command>() per subcommand. apps/liftoff/main.cc only
+// maps flags onto these option structs (CLI11) and calls them; tests call them directly.
+//
+// Every Run function writes results to `out`, diagnostics to `err`, and returns the
+// process exit code (ExitCodeFor; docs/cli.md). A failure never discards what was
+// already computed: the table command prints every trial that worked and then fails.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+#include "liftoff/core/status.h"
+
+namespace liftoff::cli {
+
+/// Exit codes: 0 success, 1 an unexpected internal error, 2 bad command-line usage, and
+/// one per Status class (docs/cli.md).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInternal = 1;
+inline constexpr int kExitUsage = 2;
+int ExitCodeFor(StatusCode code);
+/// Prints "liftoff: <status>" on `err` and returns its exit code.
+int ReportError(const Status& status, std::ostream& err);
+
+/// Options every command that converts angles takes.
+struct CalibrationChoice {
+  /// Calibration file; empty: the manifest's, else DefaultCalibrationPath().
+  std::filesystem::path calibration_path;
+};
+
+/// Options of the lookup: how the log is read and how the angle is looked up.
+struct LookupChoice {
+  /// "linear" or "hold" (sample-and-hold, the 2018 authors' rule).
+  std::string rule = "linear";
+  /// Consecutive samples further apart than this bracket a gap, seconds.
+  double gap_threshold_s = 0.25;
+  /// How far past the log's last sample a lookup is answered (held, flagged), seconds.
+  double max_past_end_s = 1.0;
+  /// Malformed log lines tolerated (skipped and reported) per log.
+  int64_t max_bad_lines = 0;
+};
+
+/// `liftoff table MANIFEST`: per-trial angles at liftoff and the per-foot table.
+struct TableCommand {
+  std::filesystem::path manifest_path;
+  CalibrationChoice calibration;
+  LookupChoice lookup;
+  /// "md", "csv", "latex", "json".
+  std::string format = "md";
+  /// "both", "trials" or "feet".
+  std::string tables = "both";
+  /// Simulation results JSON (docs/formats.md) for the simulation columns; empty: blank.
+  std::filesystem::path sim_path;
+  /// Write the tables here instead of `out`.
+  std::filesystem::path output_path;
+};
+int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err);
+
+/// `liftoff import-2018 FOLDER -o MANIFEST`: the 2018 folder as a trial manifest.
+struct Import2018Command {
+  std::filesystem::path folder;
+  std::filesystem::path output_path;
+  /// Overwrite an existing manifest.
+  bool force = false;
+};
+int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostream& err);
+
+/// `liftoff sync LOG --led-on S --liftoff S`: one lookup, the rotation at liftoff.
+struct SyncCommand {
+  std::filesystem::path log_path;
+  /// "auto", "liftoff", "laika-2018".
+  std::string log_format = "auto";
+  CalibrationChoice calibration;
+  LookupChoice lookup;
+  /// Video instants, seconds from the video's start.
+  double led_on_s = 0.0;
+  double liftoff_s = 0.0;
+  /// Half-width of each instant's timing uncertainty, seconds.
+  double uncertainty_s = 0.0;
+  bool json = false;
+};
+int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err);
+
+/// `liftoff log LOG`: what a log holds (span, rate, gaps, LED, skipped lines); optionally
+/// converts it to liftoff's format.
+struct LogCommand {
+  std::filesystem::path log_path;
+  std::string log_format = "auto";
+  CalibrationChoice calibration;
+  int64_t max_bad_lines = 0;
+  double gap_threshold_s = 0.25;
+  /// Write the log in liftoff's format here.
+  std::filesystem::path convert_path;
+  bool json = false;
+};
+int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err);
+
+/// `liftoff calib [FILE]`: the calibration, its provenance and its conversions.
+struct CalibCommand {
+  CalibrationChoice calibration;
+  bool json = false;
+};
+int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err);
+
+}  // namespace liftoff::cli

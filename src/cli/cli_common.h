@@ -1,0 +1,36 @@
+// Pieces the subcommands share: choosing the calibration, reading the lookup options,
+// detecting a log's format, writing output files.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "liftoff/cli/commands.h"
+#include "liftoff/core/calibration.h"
+#include "liftoff/core/controller_log.h"
+#include "liftoff/core/manifest.h"
+#include "liftoff/sync/lookup.h"
+
+namespace liftoff::cli {
+
+/// The calibration chosen by flag, else by the manifest (`manifest_choice`), else the
+/// default one.
+Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
+                                      const std::filesystem::path& manifest_choice = {});
+
+/// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
+Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);
+
+/// Reads a log whose format is "auto", "liftoff" or "laika-2018"; "auto" looks at the
+/// first line (liftoff logs start with "# liftoff-log").
+Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std::string& format,
+                                    const Calibration& calibration, const LogReadOptions& options);
+
+/// Writes `text` to `path` (through a temporary file renamed into place).
+Status WriteTextFile(const std::filesystem::path& path, const std::string& text);
+
+/// Prints each line of a log's read report that a person should see ("warning: ...").
+void PrintLogWarnings(const LogReadReport& report, std::ostream& err);
+
+}  // namespace liftoff::cli
