@@ -3,6 +3,7 @@
 // 600,000 lines), and the time of one lookup in a long log.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -18,13 +19,14 @@ namespace {
 
 using namespace liftoff;
 
+// The shipped calibration (calib/laika-2018.json); the benchmark stops if it is missing.
 Calibration BenchCalibration() {
-  Calibration calibration;
-  calibration.name = "bench";
-  calibration.encoder_counts_per_motor_rev = 12;
-  calibration.gearbox_ratio = 1000;
-  calibration.spur_gear_ratio = 4;
-  return calibration;
+  auto calibration = LoadCalibration(DefaultCalibrationPath());
+  if (!calibration.ok()) {
+    std::fprintf(stderr, "%s\n", calibration.status().ToString().c_str());
+    std::exit(1);
+  }
+  return *calibration;
 }
 
 // A 1 kHz log of `samples` samples: counts, shaft and vertebra angles on a ramp.

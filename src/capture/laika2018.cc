@@ -1,5 +1,7 @@
 #include "liftoff/capture/laika2018.h"
 
+#include "liftoff/core/file.h"
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -61,20 +63,6 @@ std::string Quote(std::string_view text) {
   std::string quoted = "\"" + std::string(text.substr(0, kMaxQuoted));
   if (text.size() > kMaxQuoted) quoted += "...";
   return quoted + "\"";
-}
-
-Result<std::string> ReadWholeFile(const fs::path& path) {
-  std::error_code error;
-  if (!fs::exists(path, error)) return NotFoundError(path.string() + ": no such file");
-  if (fs::is_directory(path, error)) {
-    return InvalidArgumentError(path.string() + ": is a directory, expected a file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return IoError(path.string() + ": cannot open for reading");
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad()) return IoError(path.string() + ": read failed");
-  return contents.str();
 }
 
 // A finite double filling all of `text` ("-0.01", "2.24").

@@ -69,22 +69,6 @@ Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std
   return capture::LoadControllerLog(path, *parsed, calibration, options);
 }
 
-Status WriteTextFile(const std::filesystem::path& path, const std::string& text) {
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return IoError(path.string() + ": cannot open for writing");
-    out << text;
-    out.flush();
-    if (!out) return IoError(path.string() + ": write failed");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) return IoError(path.string() + ": cannot rename into place: " + error.message());
-  return Status::Ok();
-}
-
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err) {
   if (report.bad_lines == 0) return;
   err << "warning: " << report.Brief() << '\n';

@@ -27,9 +27,6 @@ Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);
 Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std::string& format,
                                     const Calibration& calibration, const LogReadOptions& options);
 
-/// Writes `text` to `path` (through a temporary file renamed into place).
-Status WriteTextFile(const std::filesystem::path& path, const std::string& text);
-
 /// Prints each line of a log's read report that a person should see ("warning: ...").
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err);
 

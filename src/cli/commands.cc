@@ -10,6 +10,7 @@
 
 #include "cli_common.h"
 #include "liftoff/capture/laika2018.h"
+#include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/time.h"
 #include "liftoff/stats/sim_results.h"
@@ -32,7 +33,7 @@ int Emit(const std::string& text, const std::filesystem::path& output_path, std:
     out << text;
     return kExitOk;
   }
-  const Status written = WriteTextFile(output_path, text);
+  const Status written = WriteFileAtomically(output_path, text);
   if (!written.ok()) return ReportError(written, err);
   err << "wrote " << output_path.string() << '\n';
   return kExitOk;

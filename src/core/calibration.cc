@@ -1,5 +1,7 @@
 #include "liftoff/core/calibration.h"
 
+#include "liftoff/core/file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -172,7 +174,7 @@ Status Calibration::Validate() const {
 
 std::string Calibration::Brief() const {
   if (source_path.empty()) return name + " (built in code)";
-  return name + " (" + source_path.string() + ")";
+  return name + " (" + DisplayPath(source_path) + ")";
 }
 
 // ---------------------------------------------------------------------------------------

@@ -1,5 +1,7 @@
 #include "liftoff/core/controller_log.h"
 
+#include "liftoff/core/file.h"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -628,6 +630,7 @@ Status WriteControllerLog(const std::filesystem::path& path, const ControllerLog
   }
 
   // write beside the target, then rename: readers never see half a file
+  LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(path));
   std::filesystem::path temporary = path;
   temporary += ".tmp";
   ControllerLogWriter writer;
@@ -644,14 +647,10 @@ Status WriteControllerLog(const std::filesystem::path& path, const ControllerLog
     }
   }
   if (status.ok()) status = writer.Close();
-  std::error_code error;
-  if (status.ok()) {
-    std::filesystem::rename(temporary, path, error);
-    if (!error) return Status::Ok();
-    status = IoError(path.string() + ": cannot rename into place: " + error.message());
-  }
+  if (status.ok()) return RenameIntoPlace(temporary, path);
   (void)writer.Close();
-  std::filesystem::remove(temporary, error);
+  std::error_code ignored;
+  std::filesystem::remove(temporary, ignored);
   return status;
 }
 

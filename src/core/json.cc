@@ -1,5 +1,7 @@
 #include "liftoff/core/json.h"
 
+#include "liftoff/core/file.h"
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -90,36 +92,12 @@ Result<json> ParseJsonText(std::string_view text, std::string_view source_name) 
 }
 
 Result<json> LoadJsonFile(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) {
-    return NotFoundError(path.string() + ": no such file");
-  }
-  if (std::filesystem::is_directory(path, error)) {
-    return InvalidArgumentError(path.string() + ": is a directory, expected a JSON file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return IoError(path.string() + ": cannot open for reading");
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad()) return IoError(path.string() + ": read failed");
-  return ParseJsonText(contents.str(), path.string());
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path));
+  return ParseJsonText(contents, path.string());
 }
 
 Status WriteJsonFile(const std::filesystem::path& path, const json& document, int indent) {
-  // write beside the target, then rename: readers never see half a file
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return IoError(path.string() + ": cannot open for writing");
-    out << document.dump(indent) << '\n';
-    out.flush();
-    if (!out) return IoError(path.string() + ": write failed");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) return IoError(path.string() + ": cannot rename into place: " + error.message());
-  return Status::Ok();
+  return WriteFileAtomically(path, document.dump(indent) + "\n");
 }
 
 // ---------------------------------------------------------------------------------------

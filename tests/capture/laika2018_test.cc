@@ -20,15 +20,6 @@ using ::liftoff::testing::ScratchDir;
 using ::liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
 
-// The 2018 drive chain, built in code: 12 counts per rotor rev, 1000:1 gearbox, 4:1 spur.
-Calibration TestCalibration() {
-  Calibration calibration;
-  calibration.name = "test";
-  calibration.encoder_counts_per_motor_rev = 12;
-  calibration.gearbox_ratio = 1000;
-  calibration.spur_gear_ratio = 4;
-  return calibration;
-}
 
 // ---------------------------------------------------------------------------------------
 // ImportLaika2018Log on small synthetic files
@@ -36,7 +27,7 @@ Calibration TestCalibration() {
 TEST(Laika2018Log, ReadsBareCrLinesWithTrailingCommas) {
   ScratchDir dir;
   WriteFile(dir / "Test1 Front Right Blue.txt", "4,-0.01,\r13,-0.02,\r1074,-0.40,\r");
-  const auto log = ImportLaika2018Log(dir / "Test1 Front Right Blue.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "Test1 Front Right Blue.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[0].device_time_ns, 4'000'000);
@@ -65,7 +56,7 @@ TEST(Laika2018Log, ReadsBareCrLinesWithTrailingCommas) {
 TEST(Laika2018Log, ReadsCrLfLinesAndIgnoresBlankOnes) {
   ScratchDir dir;
   WriteFile(dir / "crlf.txt", "11,-0.01,\r\n\r\n17,-0.02,\r\n\r\n");
-  const auto log = ImportLaika2018Log(dir / "crlf.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "crlf.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 2u);
   EXPECT_EQ(log->samples[1].device_time_ns, 17'000'000);
@@ -78,7 +69,7 @@ TEST(Laika2018Log, ReadsLfLinesWithoutTrailingComma) {
   ScratchDir dir;
   // no line end after the last line: complete, since no line carries a trailing comma
   WriteFile(dir / "lf.txt", "1,0.5\n2,0.75\n3,2.5e-1");
-  const auto log = ImportLaika2018Log(dir / "lf.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "lf.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[2].device_time_ns, 3'000'000);
@@ -90,7 +81,7 @@ TEST(Laika2018Log, ReadsLfLinesWithoutTrailingComma) {
 TEST(Laika2018Log, ParsesFractionalMillisecondsExactly) {
   ScratchDir dir;
   WriteFile(dir / "fraction.txt", "1074.33,0.1,\r");
-  const auto log = ImportLaika2018Log(dir / "fraction.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "fraction.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->samples[0].device_time_ns, 1'074'330'000);
 }
@@ -98,7 +89,7 @@ TEST(Laika2018Log, ParsesFractionalMillisecondsExactly) {
 TEST(Laika2018Log, ToleratesTruncatedLastLineWithoutLineEnd) {
   ScratchDir dir;
   WriteFile(dir / "cut.txt", "1,0.5,\r2,0.6,\r1074.33");
-  const auto log = ImportLaika2018Log(dir / "cut.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "cut.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->samples.size(), 2u);
   EXPECT_TRUE(log->report.truncated_last_line);
@@ -114,7 +105,7 @@ TEST(Laika2018Log, ToleratesMalformedLastLineFollowedByBlankLines) {
   // as in the real files: "...\r1074.33\r\r"
   ScratchDir dir;
   WriteFile(dir / "tail.txt", "1,0.5,\r2,0.6,\r1074.33\r\r");
-  const auto log = ImportLaika2018Log(dir / "tail.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "tail.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->samples.size(), 2u);
   EXPECT_TRUE(log->report.truncated_last_line);
@@ -126,13 +117,13 @@ TEST(Laika2018Log, UnendedLastLineMissingItsTrailingCommaMayHaveLostDigits) {
   // "3,0.8" may be the start of "3,0.85,": every other line carries the comma
   ScratchDir dir;
   WriteFile(dir / "cut.txt", "1,0.5,\r2,0.6,\r3,0.8");
-  const auto log = ImportLaika2018Log(dir / "cut.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "cut.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->samples.size(), 2u);
   EXPECT_TRUE(log->report.truncated_last_line);
   // an unended last line that is complete is kept
   WriteFile(dir / "whole.txt", "1,0.5,\r2,0.6,\r3,0.8,");
-  const auto whole = ImportLaika2018Log(dir / "whole.txt", TestCalibration());
+  const auto whole = ImportLaika2018Log(dir / "whole.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(whole.ok()) << whole.status().ToString();
   EXPECT_EQ(whole->samples.size(), 3u);
   EXPECT_FALSE(whole->report.truncated_last_line);
@@ -141,7 +132,7 @@ TEST(Laika2018Log, UnendedLastLineMissingItsTrailingCommaMayHaveLostDigits) {
 TEST(Laika2018Log, GarbageMiddleLineIsAnErrorNamingFileAndLine) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "1,0.1,\r\n2,0.2,\r\n\r\n2x,0.3,\r\n4,0.4,\r\n");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kParse);
   // line 3 is blank; the garbage is on line 4
@@ -153,7 +144,7 @@ TEST(Laika2018Log, GarbageMiddleLineIsAnErrorNamingFileAndLine) {
 TEST(Laika2018Log, GarbageMiddleLineIsToleratedWithMaxBadLines) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "1,0.1,\r2,0.2,\rmotor fault\r4,0.4,\r");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", TestCalibration(), {.max_bad_lines = 1});
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 1});
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[2].device_time_ns, 4'000'000);
@@ -168,7 +159,7 @@ TEST(Laika2018Log, GarbageMiddleLineIsToleratedWithMaxBadLines) {
 TEST(Laika2018Log, MoreBadLinesThanAllowedNamesTheFirstAndTheCount) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "1,0.1,\r2,,\r3,0.3,\rabc\r,0.5,\r6,0.6,\r");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", TestCalibration(), {.max_bad_lines = 2});
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 2});
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kParse);
   EXPECT_THAT(log.status().message(), HasSubstr("bad.txt:2: expected `t_ms,value,`, got \"2,,\""));
@@ -178,7 +169,7 @@ TEST(Laika2018Log, MoreBadLinesThanAllowedNamesTheFirstAndTheCount) {
 TEST(Laika2018Log, KeepsOnlyTheFirstIssuesButCountsAll) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "x\ry\rz\r1,0.1,\r");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", TestCalibration(),
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(),
                                       {.max_bad_lines = 5, .max_issues_kept = 2});
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->report.bad_lines, 3);
@@ -191,7 +182,7 @@ TEST(Laika2018Log, EmptyFileHasNoSamples) {
   WriteFile(dir / "empty.txt", "");
   WriteFile(dir / "blank.txt", "\r\r\n\n");
   for (const char* name : {"empty.txt", "blank.txt"}) {
-    const auto log = ImportLaika2018Log(dir / name, TestCalibration());
+    const auto log = ImportLaika2018Log(dir / name, liftoff::testing::DriveChainCalibration());
     ASSERT_FALSE(log.ok()) << name;
     EXPECT_EQ(log.status().code(), StatusCode::kParse);
     EXPECT_THAT(log.status().message(), HasSubstr(name));
@@ -202,7 +193,7 @@ TEST(Laika2018Log, EmptyFileHasNoSamples) {
 TEST(Laika2018Log, FileOfOnlyATruncatedLineHasNoSamples) {
   ScratchDir dir;
   WriteFile(dir / "stub.txt", "107");
-  const auto log = ImportLaika2018Log(dir / "stub.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "stub.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kParse);
   EXPECT_THAT(log.status().message(), HasSubstr("stub.txt: no samples"));
@@ -210,7 +201,7 @@ TEST(Laika2018Log, FileOfOnlyATruncatedLineHasNoSamples) {
 
 TEST(Laika2018Log, MissingFileIsNotFound) {
   ScratchDir dir;
-  const auto log = ImportLaika2018Log(dir / "absent.txt", TestCalibration());
+  const auto log = ImportLaika2018Log(dir / "absent.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kNotFound);
   EXPECT_THAT(log.status().message(), HasSubstr("absent.txt"));
@@ -219,7 +210,7 @@ TEST(Laika2018Log, MissingFileIsNotFound) {
 TEST(Laika2018Log, NonIncreasingTimeIsDroppedAndCounted) {
   ScratchDir dir;
   WriteFile(dir / "order.txt", "1,0.1,\r5,0.2,\r4,0.3,\r5,0.4,\r6,0.5,\r");
-  const auto log = ImportLaika2018Log(dir / "order.txt", TestCalibration(), {.max_bad_lines = 2});
+  const auto log = ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 2});
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[1].device_time_ns, 5'000'000);
@@ -231,7 +222,7 @@ TEST(Laika2018Log, NonIncreasingTimeIsDroppedAndCounted) {
   EXPECT_EQ(log->report.issues[0].line, 3);
   EXPECT_EQ(log->report.issues[1].line, 4);
 
-  const auto strict = ImportLaika2018Log(dir / "order.txt", TestCalibration());
+  const auto strict = ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(strict.ok());
   EXPECT_EQ(strict.status().code(), StatusCode::kParse);
   EXPECT_THAT(strict.status().message(), HasSubstr("order.txt:3: t_ms: expected more than the previous sample's 5, got \"4\""));
@@ -240,7 +231,7 @@ TEST(Laika2018Log, NonIncreasingTimeIsDroppedAndCounted) {
 TEST(Laika2018Log, InvalidOptionsAreRejected) {
   ScratchDir dir;
   WriteFile(dir / "ok.txt", "1,0.1,\r");
-  const auto log = ImportLaika2018Log(dir / "ok.txt", TestCalibration(), {.max_bad_lines = -1});
+  const auto log = ImportLaika2018Log(dir / "ok.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = -1});
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(log.status().message(), HasSubstr("max_bad_lines"));
@@ -252,7 +243,7 @@ TEST(Laika2018Log, InvalidOptionsAreRejected) {
 TEST(LoadControllerLog, DispatchesLaika2018ToTheImporter) {
   ScratchDir dir;
   WriteFile(dir / "old.txt", "10,2.0,\r");
-  const auto log = LoadControllerLog(dir / "old.txt", LogFormat::kLaika2018, TestCalibration());
+  const auto log = LoadControllerLog(dir / "old.txt", LogFormat::kLaika2018, liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->report.format, "laika-2018");
   EXPECT_DOUBLE_EQ(log->samples[0].vertebra_rad, 0.5);
@@ -281,7 +272,7 @@ TEST(LoadControllerLog, FillsAnglesOfALiftoffLogFromCounts) {
   complete.bend_spool_rad = 0.5;
   ASSERT_TRUE(WriteControllerLog(dir / "new.log", written).ok());
 
-  const auto log = LoadControllerLog(dir / "new.log", LogFormat::kLiftoff, TestCalibration());
+  const auto log = LoadControllerLog(dir / "new.log", LogFormat::kLiftoff, liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_NEAR(log->samples[0].rotate_shaft_rad, 2 * std::numbers::pi, 1e-12);
@@ -297,13 +288,13 @@ TEST(LoadControllerLog, FillsAnglesOfALiftoffLogFromCounts) {
 TEST(LoadControllerLog, ErrorsNameTheFile) {
   ScratchDir dir;
   for (LogFormat format : {LogFormat::kLiftoff, LogFormat::kLaika2018}) {
-    const auto log = LoadControllerLog(dir / "nowhere.log", format, TestCalibration());
+    const auto log = LoadControllerLog(dir / "nowhere.log", format, liftoff::testing::DriveChainCalibration());
     ASSERT_FALSE(log.ok());
     EXPECT_EQ(log.status().code(), StatusCode::kNotFound);
     EXPECT_THAT(log.status().message(), HasSubstr("nowhere.log"));
   }
   WriteFile(dir / "garbage.log", "this is not a log\n");
-  const auto log = LoadControllerLog(dir / "garbage.log", LogFormat::kLiftoff, TestCalibration());
+  const auto log = LoadControllerLog(dir / "garbage.log", LogFormat::kLiftoff, liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_THAT(log.status().message(), HasSubstr("garbage.log"));
 }
@@ -500,7 +491,7 @@ TEST(Laika2018Folder, ColumnHeaderMustNameTheFoot) {
 TEST(Laika2018Reference, AllTwentyLogsImportWithOnlyTruncatedLastLinesSkipped) {
   LIFTOFF_REQUIRE_REFERENCE(ref);
   const auto folder = ref / "laika-2018-hardware";
-  const Calibration calibration = TestCalibration();
+  const Calibration calibration = liftoff::testing::DriveChainCalibration();
   std::set<std::string> truncated;
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
@@ -528,7 +519,7 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   LIFTOFF_REQUIRE_REFERENCE(ref);
   const auto folder = ref / "laika-2018-hardware";
   // counted with `tr '\r' '\n' | grep -c` and read with `od -c`
-  const auto front_left = ImportLaika2018Log(folder / "Test1 Front Left Orange.txt", TestCalibration());
+  const auto front_left = ImportLaika2018Log(folder / "Test1 Front Left Orange.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(front_left.ok()) << front_left.status().ToString();
   EXPECT_EQ(front_left->samples.size(), 169u);
   EXPECT_EQ(front_left->samples.front().device_time_ns, 10'000'000);
@@ -540,7 +531,7 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   EXPECT_THAT(front_left->report.issues[0].reason, HasSubstr("\"1074.33\""));
 
   // the one CR LF file
-  const auto crlf = ImportLaika2018Log(folder / "Test3 Back Left Red.txt", TestCalibration());
+  const auto crlf = ImportLaika2018Log(folder / "Test3 Back Left Red.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(crlf.ok()) << crlf.status().ToString();
   EXPECT_EQ(crlf->samples.size(), 152u);
   EXPECT_EQ(crlf->report.lines_total, 152);
@@ -548,7 +539,7 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   EXPECT_EQ(crlf->samples.back().device_time_ns, 8'078'000'000);
   EXPECT_DOUBLE_EQ(crlf->samples.back().rotate_shaft_rad, -1.83);
 
-  const auto back_left = ImportLaika2018Log(folder / "Test1 Back Left Red.txt", TestCalibration());
+  const auto back_left = ImportLaika2018Log(folder / "Test1 Back Left Red.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(back_left.ok()) << back_left.status().ToString();
   EXPECT_EQ(back_left->samples.size(), 187u);
   EXPECT_EQ(back_left->samples.back().device_time_ns, 10'073'000'000);
@@ -599,7 +590,7 @@ TEST(Laika2018Reference, AuthorsLookupReproducesTheDocumentedAngles) {
   ASSERT_EQ(imported->manifest.trials.size(), expected_rad.size());
   for (size_t i = 0; i < expected_rad.size(); ++i) {
     const TrialRecord& trial = imported->manifest.trials[i];
-    const auto log = LoadControllerLog(trial.log_path, trial.log_format, TestCalibration());
+    const auto log = LoadControllerLog(trial.log_path, trial.log_format, liftoff::testing::DriveChainCalibration());
     ASSERT_TRUE(log.ok()) << log.status().ToString();
     const int64_t since_led_ns = trial.times->liftoff_ns - trial.times->led_on_ns;
     const auto after = std::upper_bound(

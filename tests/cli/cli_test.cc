@@ -284,6 +284,23 @@ TEST(CliSync, OneLookupHoldVersusLinear) {
   EXPECT_NEAR(hold["liftoff_rad"].get<double>(), 2.2 / 4, 1e-9);  // sample at 2.2 s
 }
 
+TEST(Samples, RegenerateByteForByte) {
+  ScratchDir scratch;
+  const std::string command = std::string("\"") + SAMPLE_GENERATOR + "\" " +
+                              Quoted(scratch / "trials") + " >/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const std::filesystem::path committed = SourceDir() / "samples" / "trials";
+  int compared = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(committed)) {
+    if (!entry.is_regular_file()) continue;
+    const auto relative = entry.path().lexically_relative(committed);
+    EXPECT_EQ(ReadFile(scratch / "trials" / relative.string()), ReadFile(entry.path()))
+        << relative << " differs from what make_sample_trials writes";
+    ++compared;
+  }
+  EXPECT_EQ(compared, 10);  // manifest, expected values and eight logs
+}
+
 TEST(CliImport2018, ReferenceDataGivesThePublishedSampleAndHoldValues) {
   LIFTOFF_REQUIRE_REFERENCE(reference);
   ScratchDir scratch;

@@ -563,13 +563,22 @@ TEST(ControllerLog, WriterRefusesWhatWouldBreakTheFile) {
   EXPECT_FALSE(std::filesystem::exists(dir / "b.csv"));
 }
 
-TEST(ControllerLog, WriteToAMissingFolderIsAnIoError) {
+TEST(ControllerLog, WriteCreatesAMissingFolder) {
   ScratchDir dir;
   ControllerLog log;
   log.samples = {SampleAt(0, std::nullopt)};
-  const Status status = WriteControllerLog(dir / "no" / "such" / "log.csv", log);
+  ASSERT_TRUE(WriteControllerLog(dir / "no" / "such" / "log.csv", log).ok());
+  EXPECT_TRUE(ReadControllerLog(dir / "no" / "such" / "log.csv").ok());
+}
+
+TEST(ControllerLog, WriteBelowAFileIsAnIoError) {
+  ScratchDir dir;
+  liftoff::testing::WriteFile(dir / "plain-file", "x");
+  ControllerLog log;
+  log.samples = {SampleAt(0, std::nullopt)};
+  const Status status = WriteControllerLog(dir / "plain-file" / "log.csv", log);
   EXPECT_EQ(status.code(), StatusCode::kIo);
-  EXPECT_THAT(status.message(), HasSubstr("log.csv"));
+  EXPECT_THAT(status.message(), HasSubstr("plain-file"));
 }
 
 TEST(ControllerLog, EventKindNamesRoundTrip) {

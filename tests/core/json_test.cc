@@ -83,11 +83,18 @@ TEST(WriteJsonFile, WritesIndentedJsonThatReadsBack) {
   EXPECT_EQ(LoadJsonFile(path).value(), document);
 }
 
-TEST(WriteJsonFile, UnwritableFolderIsIoError) {
+TEST(WriteJsonFile, CreatesMissingFolders) {
   ScratchDir dir;
-  const Status status = WriteJsonFile(dir / "no" / "such" / "folder" / "x.json", json::object());
+  ASSERT_TRUE(WriteJsonFile(dir / "no" / "such" / "x.json", json::object()).ok());
+  EXPECT_EQ(LoadJsonFile(dir / "no" / "such" / "x.json").value(), json::object());
+}
+
+TEST(WriteJsonFile, FolderBelowAFileIsIoError) {
+  ScratchDir dir;
+  liftoff::testing::WriteFile(dir / "plain-file", "x");
+  const Status status = WriteJsonFile(dir / "plain-file" / "x.json", json::object());
   EXPECT_EQ(status.code(), StatusCode::kIo);
-  EXPECT_THAT(status.message(), HasSubstr("x.json"));
+  EXPECT_THAT(status.message(), HasSubstr("plain-file"));
 }
 
 TEST(JsonPointerEscape, EscapesTildeAndSlash) {

@@ -37,6 +37,15 @@ ScratchDir::~ScratchDir() {
   std::filesystem::remove_all(path_, ignored);
 }
 
+Calibration DriveChainCalibration() {
+  Calibration calibration;
+  calibration.name = "test";
+  calibration.encoder_counts_per_motor_rev = 12;
+  calibration.gearbox_ratio = 1000;
+  calibration.spur_gear_ratio = 4;
+  return calibration;
+}
+
 void WriteFile(const std::filesystem::path& path, const std::string& contents) {
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

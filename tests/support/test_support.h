@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "liftoff/core/calibration.h"
+
 namespace liftoff::testing {
 
 /// The liftoff source tree (for calib/, samples/).
@@ -30,6 +32,11 @@ class ScratchDir {
  private:
   std::filesystem::path path_;
 };
+
+/// The 2018 drive chain built in code, independent of calib/: 12 counts per rotor
+/// revolution, 1000:1 gearbox, 4:1 spur gear (so a vertebra angle is a quarter of the
+/// output shaft's). Name "test".
+Calibration DriveChainCalibration();
 
 /// Writes `contents` to `path` byte for byte (creating parent folders).
 void WriteFile(const std::filesystem::path& path, const std::string& contents);

@@ -19,15 +19,6 @@ using ::testing::StartsWith;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::WriteFile;
 
-// the 2018 drive chain, built in code: the vertebra turns a quarter of the shaft
-Calibration TestCalibration() {
-  Calibration calibration;
-  calibration.name = "test";
-  calibration.encoder_counts_per_motor_rev = 12;
-  calibration.gearbox_ratio = 1000;
-  calibration.spur_gear_ratio = 4;
-  return calibration;
-}
 
 EventTimes HandTimes(int64_t led_on_ms, int64_t liftoff_ms) {
   EventTimes times;
@@ -71,7 +62,7 @@ TEST(AnalyzeManifest, AMissingLogFailsOnlyItsTrialAndNamesTheFile) {
   manifest.trials.push_back(Trial("B2", Foot::kB, scratch / "missing.txt"));
   manifest.trials.back().times = HandTimes(5000, 5350);
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, TestCalibration(), Hold());
+  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   ASSERT_EQ(analysis.outcomes.size(), 2u);
   EXPECT_EQ(analysis.failed, 1);
   EXPECT_EQ(analysis.rule, LookupRule::kSampleAndHold);
@@ -110,7 +101,7 @@ TEST(AnalyzeManifest, ValuesFlagGapsAndQueriesPastTheEnd) {
   manifest.trials.push_back(Trial("D3", Foot::kD, scratch / "bursts.txt"));
   manifest.trials.back().times = HandTimes(1000, 7530);  // log 6.530 s: 0.5 s past the end
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, TestCalibration(), Hold());
+  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   EXPECT_EQ(analysis.failed, 0);
   const std::vector<stats::TrialValue> values = analysis.Values();
   ASSERT_EQ(values.size(), 2u);
@@ -133,7 +124,7 @@ TEST(AnalyzeManifest, TrialsWithoutTimesFailWithTheirReason) {
   manifest.trials.push_back(Trial("A3", Foot::kA, scratch / "good.txt"));
   manifest.trials.back().times = HandTimes(0, 700);
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, TestCalibration(), Hold());
+  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   ASSERT_EQ(analysis.outcomes.size(), 3u);
   EXPECT_EQ(analysis.failed, 2);
   const Status& video_only = analysis.outcomes[0].status;
@@ -157,7 +148,7 @@ TEST(AnalyzeManifest, LookupErrorsNameTheTrialAndTheLog) {
   manifest.trials.push_back(Trial("C4", Foot::kC, scratch / "short.txt"));
   manifest.trials.back().times = HandTimes(0, 5000);  // 4 s past the 1 s log
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, TestCalibration(), Hold());
+  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   EXPECT_EQ(analysis.failed, 1);
   const Status& status = analysis.outcomes[0].status;
   EXPECT_EQ(status.code(), StatusCode::kOutOfRange);
@@ -176,7 +167,7 @@ TEST(AnalyzeManifest, InvalidOptionsFailEveryTrial) {
   AnalysisOptions options;
   options.lookup.gap_threshold_s = -1.0;
   EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, TestCalibration(), options);
+  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), options);
   EXPECT_EQ(analysis.failed, 1);
   EXPECT_THAT(analysis.outcomes[0].status.message(), StartsWith("A1: "));
   EXPECT_THAT(analysis.outcomes[0].status.message(), HasSubstr("gap_threshold_s"));
