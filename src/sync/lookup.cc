@@ -36,6 +36,28 @@ double AngleAt(const std::vector<AnglePoint>& points, int64_t time_ns, LookupRul
   return before.vertebra_rad + fraction * (after->vertebra_rad - before.vertebra_rad);
 }
 
+// The samples with an angle around [begin_ns, end_ns]: all inside, plus two on either side
+// (or up to the log's ends), found by binary search so a lookup costs O(log n + window)
+// even in a long capture.
+std::vector<AnglePoint> AnglePointsAround(const std::vector<LogSample>& samples, int64_t begin_ns,
+                                          int64_t end_ns) {
+  const auto by_time = [](const LogSample& sample, int64_t t) { return sample.device_time_ns < t; };
+  auto lo = std::lower_bound(samples.begin(), samples.end(), begin_ns, by_time);
+  auto hi = std::lower_bound(lo, samples.end(), end_ns, by_time);
+  for (int found = 0; lo != samples.begin() && found < 2;) {
+    --lo;
+    if (!std::isnan(lo->vertebra_rad)) ++found;
+  }
+  for (int found = 0; hi != samples.end() && found < 2; ++hi) {
+    if (!std::isnan(hi->vertebra_rad)) ++found;
+  }
+  std::vector<AnglePoint> points;
+  for (auto it = lo; it != hi; ++it) {
+    if (!std::isnan(it->vertebra_rad)) points.push_back({it->device_time_ns, it->vertebra_rad});
+  }
+  return points;
+}
+
 }  // namespace
 
 std::string_view LookupRuleName(LookupRule rule) {
@@ -84,20 +106,17 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
                                 std::to_string(query_uncertainty_ns));
   }
 
-  // the samples that carry an angle
-  std::vector<AnglePoint> points;
-  points.reserve(log.samples.size());
-  for (const LogSample& sample : log.samples) {
-    if (std::isnan(sample.vertebra_rad)) continue;
-    points.push_back({sample.device_time_ns, sample.vertebra_rad});
-  }
+  // the first and last samples that carry an angle
   if (log.samples.empty()) return NotFoundError("the log has no samples");
-  if (points.empty()) {
+  const auto has_angle = [](const LogSample& sample) { return !std::isnan(sample.vertebra_rad); };
+  const auto first_sample = std::find_if(log.samples.begin(), log.samples.end(), has_angle);
+  if (first_sample == log.samples.end()) {
     return NotFoundError("none of the log's " + std::to_string(log.samples.size()) +
                          " samples has a vertebra angle");
   }
-  const AnglePoint& first = points.front();
-  const AnglePoint& last = points.back();
+  const auto last_sample = std::find_if(log.samples.rbegin(), log.samples.rend(), has_angle);
+  const AnglePoint first{first_sample->device_time_ns, first_sample->vertebra_rad};
+  const AnglePoint last{last_sample->device_time_ns, last_sample->vertebra_rad};
   const std::string span = "(log spans " + FormatSeconds(first.time_ns) + "-" +
                            FormatSeconds(last.time_ns) + " s)";
 
@@ -113,6 +132,10 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
     return OutOfRangeError("instant " + Sec(query_ns) + " is before the log's first sample at " +
                            Sec(first.time_ns) + " " + span + limit);
   }
+
+  // the samples around the query's window; every step below works on these
+  const std::vector<AnglePoint> points = AnglePointsAround(
+      log.samples, query_ns - query_uncertainty_ns, query_ns + query_uncertainty_ns);
 
   AngleLookup lookup;
   lookup.rule = options.rule;
