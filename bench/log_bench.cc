@@ -64,7 +64,8 @@ void BM_ReadLiftoffLog(benchmark::State& state) {
     benchmark::DoNotOptimize(log);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
-  state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(std::filesystem::file_size(path)));
+  state.SetBytesProcessed(state.iterations() *
+                          static_cast<int64_t>(std::filesystem::file_size(path)));
   std::filesystem::remove(path);
 }
 BENCHMARK(BM_ReadLiftoffLog)->Arg(600'000)->Unit(benchmark::kMillisecond);
@@ -75,7 +76,8 @@ void BM_ImportLaika2018Log(benchmark::State& state) {
     std::ofstream out(path, std::ios::binary);
     char line[64];
     for (int64_t i = 0; i < state.range(0); ++i) {
-      std::snprintf(line, sizeof line, "%lld,%.2f,\r", static_cast<long long>(i), static_cast<double>(i) * 1e-4);
+      std::snprintf(line, sizeof line, "%lld,%.2f,\r", static_cast<long long>(i),
+                    static_cast<double>(i) * 1e-4);
       out << line;
     }
   }

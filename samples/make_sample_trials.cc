@@ -63,8 +63,8 @@ constexpr double kRampRateRadPerS = (std::numbers::pi / 3.0) / 40.0;
 constexpr double kRampStartS = 4.0;
 constexpr double kBendStartS = 0.5;
 constexpr double kBendEndS = 3.5;
-constexpr double kBendSpoolRad = 4.0;  // spool angle at the end of the bend
-constexpr double kTailS = 3.0;          // log continues this long after liftoff
+constexpr double kBendSpoolRad = 4.0;              // spool angle at the end of the bend
+constexpr double kTailS = 3.0;                     // log continues this long after liftoff
 constexpr double kVideoUncertaintyS = 1.0 / 60.0;  // half a frame at 30 fps, rounded up
 
 double VertebraAngleAt(const SampleTrial& trial, double t_s) {
@@ -78,8 +78,8 @@ double SpoolAngleAt(double t_s) {
 }
 
 // liftoff format: 10 Hz with +-3 ms jitter, counts quantised, LED and test events.
-ControllerLog MakeLiftoffLog(const SampleTrial& trial, const Calibration& calibration,
-                             double end_s, uint64_t seed) {
+ControllerLog MakeLiftoffLog(const SampleTrial& trial, const Calibration& calibration, double end_s,
+                             uint64_t seed) {
   SplitMix64 random(seed);
   ControllerLog log;
   log.header.calibration = calibration.name;
@@ -101,11 +101,12 @@ ControllerLog MakeLiftoffLog(const SampleTrial& trial, const Calibration& calibr
     sample.sequence = sequence++;
     sample.led_on = true;
     const int64_t bend_counts = calibration.CountsFromShaftAngle(SpoolAngleAt(t_s));
-    const int64_t rotate_counts =
-        calibration.CountsFromShaftAngle(calibration.ShaftAngleFromVertebraAngle(VertebraAngleAt(trial, t_s)));
+    const int64_t rotate_counts = calibration.CountsFromShaftAngle(
+        calibration.ShaftAngleFromVertebraAngle(VertebraAngleAt(trial, t_s)));
     sample.bend_counts = bend_counts;
     sample.rotate_counts = rotate_counts;
-    sample.bend_spool_rad = calibration.SpoolAngleFromShaftAngle(calibration.ShaftAngleFromCounts(bend_counts));
+    sample.bend_spool_rad =
+        calibration.SpoolAngleFromShaftAngle(calibration.ShaftAngleFromCounts(bend_counts));
     sample.rotate_shaft_rad = calibration.ShaftAngleFromCounts(rotate_counts);
     sample.vertebra_rad = calibration.VertebraAngleFromCounts(rotate_counts);
     log.samples.push_back(sample);
@@ -117,13 +118,15 @@ ControllerLog MakeLiftoffLog(const SampleTrial& trial, const Calibration& calibr
 
 // 2018 format: bursts of 17 samples ~3.6 ms apart each second, shaft angle with two
 // decimals, bare CR line ends, a truncated last line.
-std::string MakeLaika2018Log(const SampleTrial& trial, const Calibration& calibration, double end_s) {
+std::string MakeLaika2018Log(const SampleTrial& trial, const Calibration& calibration,
+                             double end_s) {
   std::string text;
   char line[64];
   for (int second = 0; second <= static_cast<int>(end_s); ++second) {
     for (int k = 0; k < 17; ++k) {
       const int t_ms = second * 1000 + 4 + k * 4 - (k > 8 ? 1 : 0);
-      const double shaft = calibration.ShaftAngleFromVertebraAngle(VertebraAngleAt(trial, t_ms * 1e-3));
+      const double shaft =
+          calibration.ShaftAngleFromVertebraAngle(VertebraAngleAt(trial, t_ms * 1e-3));
       std::snprintf(line, sizeof line, "%d,%.2f,\r", t_ms, shaft);
       text += line;
     }
@@ -140,7 +143,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::filesystem::path folder = std::filesystem::absolute(argv[1]);
-  auto calibration = LoadCalibration(argc == 3 ? std::filesystem::path(argv[2]) : DefaultCalibrationPath());
+  auto calibration =
+      LoadCalibration(argc == 3 ? std::filesystem::path(argv[2]) : DefaultCalibrationPath());
   if (!calibration.ok()) {
     std::cerr << calibration.status().ToString() << '\n';
     return 1;
@@ -172,7 +176,8 @@ int main(int argc, char** argv) {
     // rounded to the millisecond as a person would write them down
     const double interval_s = kRampStartS + trial.liftoff_rad / kRampRateRadPerS;
     const int64_t led_on_ns = NsFromSeconds(trial.led_on_video_s);
-    const int64_t liftoff_ns = NsFromSeconds(std::round((trial.led_on_video_s + interval_s) * 1e3) / 1e3);
+    const int64_t liftoff_ns =
+        NsFromSeconds(std::round((trial.led_on_video_s + interval_s) * 1e3) / 1e3);
     const double exact_interval_s = SecondsFromNs(liftoff_ns - led_on_ns);
     const double true_liftoff_rad = std::abs(VertebraAngleAt(trial, exact_interval_s));
     const double end_s = exact_interval_s + kTailS;
@@ -188,7 +193,8 @@ int main(int argc, char** argv) {
     if (trial.laika2018_format) {
       record.log_path = folder / "logs" / (std::string(trial.id) + "-2018-format.txt");
       record.log_format = LogFormat::kLaika2018;
-      std::ofstream(record.log_path, std::ios::binary) << MakeLaika2018Log(trial, *calibration, end_s);
+      std::ofstream(record.log_path, std::ios::binary)
+          << MakeLaika2018Log(trial, *calibration, end_s);
       record.notes = "2018 serial format: bursts each second, so the lookup falls in a gap";
     } else {
       record.log_path = folder / "logs" / (std::string(trial.id) + ".csv");

@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   table_app->add_option("manifest", table.manifest_path, "Trial manifest (JSON)")->required();
   AddCalibrationFlag(table_app, table.calibration);
   AddLookupFlags(table_app, table.lookup);
-  table_app->add_option("--format,-f", table.format, "md, csv, latex or json")->capture_default_str();
+  table_app->add_option("--format,-f", table.format, "md, csv, latex or json")
+      ->capture_default_str();
   table_app->add_option("--tables", table.tables, "both, trials or feet")->capture_default_str();
   table_app->add_option("--sim", table.sim_path, "Simulation results JSON for the sim columns");
   table_app->add_option("--output,-o", table.output_path, "Write here instead of stdout");
@@ -60,8 +61,8 @@ int main(int argc, char** argv) {
   import_app->add_flag("--force", import.force, "Overwrite an existing manifest");
 
   SyncCommand sync;
-  CLI::App* sync_app = app.add_subcommand(
-      "sync", "Rotation at liftoff from one log and the two video instants");
+  CLI::App* sync_app =
+      app.add_subcommand("sync", "Rotation at liftoff from one log and the two video instants");
   sync_app->add_option("log", sync.log_path, "Controller log")->required();
   sync_app->add_option("--led-on", sync.led_on_s, "Video time of the LED switch-on, s")->required();
   sync_app->add_option("--liftoff", sync.liftoff_s, "Video time of the liftoff, s")->required();

@@ -179,32 +179,35 @@ Result<CsvRow> ParseCsvRow(std::string_view line_text, int64_t line, const std::
   size_t start = 0;
   while (true) {
     const size_t comma = line_text.find(',', start);
-    fields.push_back(Trim(line_text.substr(start, comma == std::string_view::npos
-                                                      ? std::string_view::npos
-                                                      : comma - start)));
+    fields.push_back(Trim(line_text.substr(
+        start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
   while (fields.size() > 4 && fields.back().empty()) fields.pop_back();
   const std::string prefix = where + ":" + std::to_string(line) + ": ";
   if (fields.size() < 4 || fields.size() > 5) {
-    return ParseError(prefix + "expected `foot,test,LED-on time (s),liftoff time (s),difference (s)`, got " +
+    return ParseError(prefix +
+                      "expected `foot,test,LED-on time (s),liftoff time (s),difference (s)`, got " +
                       Quote(line_text));
   }
   CsvRow row;
   row.line = line;
   // foot and test number
   const std::optional<Foot> foot = ParseFoot(fields[0]);
-  if (!foot) return ParseError(prefix + "column 1 (foot): expected one of A, B, C, D, got " + Quote(fields[0]));
+  if (!foot)
+    return ParseError(prefix + "column 1 (foot): expected one of A, B, C, D, got " +
+                      Quote(fields[0]));
   row.foot = *foot;
   const std::optional<int> test_number = ParsePositiveInt(fields[1]);
   if (!test_number) {
-    return ParseError(prefix + "column 2 (test): expected an integer >= 1, got " + Quote(fields[1]));
+    return ParseError(prefix + "column 2 (test): expected an integer >= 1, got " +
+                      Quote(fields[1]));
   }
   row.test_number = *test_number;
   // times, parsed exactly
   const auto parse_seconds = [&](size_t column, std::string_view name,
-                                  bool allow_negative) -> Result<int64_t> {
+                                 bool allow_negative) -> Result<int64_t> {
     const std::string_view text = fields[column];
     Result<int64_t> ns = ParseDecimalNs(text, kNanosecondsPerSecond);
     if (!ns.ok() || (*ns < 0 && !allow_negative)) {
@@ -271,7 +274,8 @@ Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration
     std::string reason;
     if (!sample) {
       reason = std::string(kExpectedLine) + ", got " + Quote(content);
-    } else if (!log.samples.empty() && sample->device_time_ns <= log.samples.back().device_time_ns) {
+    } else if (!log.samples.empty() &&
+               sample->device_time_ns <= log.samples.back().device_time_ns) {
       ++log.report.out_of_order;
       reason = "t_ms: expected more than the previous sample's " + std::string(previous_time_text) +
                ", got " + Quote(content.substr(0, content.find(',')));
@@ -355,7 +359,8 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
   Laika2018FolderImport result;
   TrialManifest& manifest = result.manifest;
   manifest.base_dir = fs::absolute(manifest_path).lexically_normal().parent_path();
-  manifest.description = "2018 Laika hardware tests (IROS 2018), imported from " + folder_abs.string();
+  manifest.description =
+      "2018 Laika hardware tests (IROS 2018), imported from " + folder_abs.string();
 
   // a spreadsheet drops trailing zeros ("10" for 10.00), so a column's resolution is the
   // finest digit printed anywhere in it
@@ -397,9 +402,9 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
       const int64_t computed_ns = row.liftoff_ns - row.led_on_ns;
       if (std::llabs(*row.difference_ns - computed_ns) > kDifferenceToleranceNs) {
         result.warnings.push_back(trial.id + ": difference column says " +
-                                  FormatSeconds(*row.difference_ns, 3) + " s but liftoff - LED-on = " +
-                                  FormatSeconds(computed_ns, 3) + " s (" + where + ":" +
-                                  std::to_string(row.line) + ")");
+                                  FormatSeconds(*row.difference_ns, 3) +
+                                  " s but liftoff - LED-on = " + FormatSeconds(computed_ns, 3) +
+                                  " s (" + where + ":" + std::to_string(row.line) + ")");
       }
     }
   }
@@ -408,7 +413,8 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
   std::set<std::string> unused_logs;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
-    if (entry.path().extension() == ".txt" && name.rfind("Test", 0) == 0 && !used_logs.count(name)) {
+    if (entry.path().extension() == ".txt" && name.rfind("Test", 0) == 0 &&
+        !used_logs.count(name)) {
       unused_logs.insert(name);
     }
   }

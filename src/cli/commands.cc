@@ -63,8 +63,8 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   // inputs: manifest, calibration, optional simulation results
   auto manifest = LoadManifest(command.manifest_path);
   if (!manifest.ok()) return ReportError(manifest.status(), err);
-  auto calibration = ChooseCalibration(command.calibration,
-                                       manifest->calibration_path.value_or(std::filesystem::path()));
+  auto calibration = ChooseCalibration(
+      command.calibration, manifest->calibration_path.value_or(std::filesystem::path()));
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   std::optional<stats::SimResults> sim;
   if (!command.sim_path.empty()) {
@@ -94,8 +94,8 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   // tables
   const std::vector<stats::TrialValue> values = analysis.Values();
   const std::string rule_name(sync::LookupRuleName(analysis.rule));
-  const stats::ResultsTable table = stats::BuildResultsTable(
-      values, sim ? &*sim : nullptr, analysis.calibration, rule_name);
+  const stats::ResultsTable table =
+      stats::BuildResultsTable(values, sim ? &*sim : nullptr, analysis.calibration, rule_name);
   std::string text;
   if (command.tables == "trials") {
     text = stats::RenderTrialTable(values, *format, analysis.calibration, rule_name);
@@ -254,8 +254,10 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
         {"gap_threshold_s", command.gap_threshold_s},
         {"longest_gap_s", SecondsFromNs(longest_gap_ns)},
         {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
-        {"vertebra_min_rad", std::isfinite(min_angle) ? nlohmann::json(min_angle) : nlohmann::json()},
-        {"vertebra_max_rad", std::isfinite(max_angle) ? nlohmann::json(max_angle) : nlohmann::json()},
+        {"vertebra_min_rad",
+         std::isfinite(min_angle) ? nlohmann::json(min_angle) : nlohmann::json()},
+        {"vertebra_max_rad",
+         std::isfinite(max_angle) ? nlohmann::json(max_angle) : nlohmann::json()},
         {"bad_lines", log->report.bad_lines},
         {"truncated_last_line", log->report.truncated_last_line},
     };
@@ -273,8 +275,8 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
           << FormatSeconds(longest_gap_at_ns) << " s)";
     }
     out << '\n'
-        << "  LED on: " << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)")
-        << '\n';
+        << "  LED on: "
+        << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)") << '\n';
     if (std::isfinite(min_angle)) {
       out << "  vertebra angle: " << Fixed(min_angle, 4) << " .. " << Fixed(max_angle, 4)
           << " rad (calibration " << calibration->Brief() << ")\n";
@@ -303,9 +305,9 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err) 
   const double counts_per_shaft_rev = c.encoder_counts_per_motor_rev * c.gearbox_ratio;
   out << "calibration: " << c.Brief() << '\n';
   if (!c.description.empty()) out << "  " << c.description << '\n';
-  out << "rotating vertebra: " << Fixed(c.encoder_counts_per_motor_rev, 0)
-      << " counts/motor rev x " << Fixed(c.gearbox_ratio, 0) << ":1 gearbox x "
-      << Fixed(c.spur_gear_ratio, 2) << ":1 spur gear\n"
+  out << "rotating vertebra: " << Fixed(c.encoder_counts_per_motor_rev, 0) << " counts/motor rev x "
+      << Fixed(c.gearbox_ratio, 0) << ":1 gearbox x " << Fixed(c.spur_gear_ratio, 2)
+      << ":1 spur gear\n"
       << "  " << Fixed(counts_per_shaft_rev, 0) << " counts per output-shaft revolution, "
       << Fixed(counts_per_shaft_rev * c.spur_gear_ratio, 0) << " per vertebra revolution\n"
       << "  one count = " << Fixed(c.VertebraAngleFromCounts(1) * 1e6, 1)

@@ -46,10 +46,12 @@ std::string DescribeRange(const NumberRange& range) {
            (range.max_exclusive ? ")" : "]");
   }
   if (has_min) {
-    return std::string("a number ") + (range.min_exclusive ? "> " : ">= ") + FormatNumber(range.min);
+    return std::string("a number ") + (range.min_exclusive ? "> " : ">= ") +
+           FormatNumber(range.min);
   }
   if (has_max) {
-    return std::string("a number ") + (range.max_exclusive ? "< " : "<= ") + FormatNumber(range.max);
+    return std::string("a number ") + (range.max_exclusive ? "< " : "<= ") +
+           FormatNumber(range.max);
   }
   return "a finite number";
 }
@@ -113,7 +115,8 @@ Status Calibration::Validate() const {
       check.Fail(where + "/name", "material \"" + material.name + "\" is listed twice");
     }
     check.Number(where + "/stiffness_n_per_m", material.stiffness_n_per_m, kPositive);
-    check.Number(where + "/stiffness_stddev_n_per_m", material.stiffness_stddev_n_per_m, kNonNegative);
+    check.Number(where + "/stiffness_stddev_n_per_m", material.stiffness_stddev_n_per_m,
+                 kNonNegative);
   }
 
   // tension points: named once each, in order low .. high
@@ -141,8 +144,9 @@ Status Calibration::Validate() const {
     }
     if (point.silicone_n_per_m < previous.silicone_n_per_m) {
       check.Fail(where + "/silicone_n_per_m", "expected at least the previous point's " +
-                                                  FormatNumber(previous.silicone_n_per_m) + ", got " +
-                                                  FormatNumber(point.silicone_n_per_m) + order);
+                                                  FormatNumber(previous.silicone_n_per_m) +
+                                                  ", got " + FormatNumber(point.silicone_n_per_m) +
+                                                  order);
     }
     if (point.buna_n_n_per_m < previous.buna_n_n_per_m) {
       check.Fail(where + "/buna_n_n_per_m", "expected at least the previous point's " +
@@ -163,8 +167,9 @@ Status Calibration::Validate() const {
         known = false;  // not a JSON pointer at all
       }
       if (!known) {
-        check.Fail(where, "expected the JSON pointer of a field of this file, such as "
-                          "\"/motor/gearbox_ratio\"");
+        check.Fail(where,
+                   "expected the JSON pointer of a field of this file, such as "
+                   "\"/motor/gearbox_ratio\"");
       }
       if (provenance.empty()) check.Fail(where, "expected a non-empty note");
     }
@@ -184,7 +189,9 @@ double Calibration::MotorAngleFromCounts(int64_t counts) const {
   return static_cast<double>(counts) / encoder_counts_per_motor_rev * kTwoPi;
 }
 
-double Calibration::ShaftAngleFromMotorAngle(double motor_rad) const { return motor_rad / gearbox_ratio; }
+double Calibration::ShaftAngleFromMotorAngle(double motor_rad) const {
+  return motor_rad / gearbox_ratio;
+}
 
 double Calibration::ShaftAngleFromCounts(int64_t counts) const {
   // one division by counts per shaft revolution: whole revolutions come out exact
@@ -207,16 +214,19 @@ double Calibration::VertebraAngleFromCounts(int64_t counts) const {
   return VertebraAngleFromShaftAngle(ShaftAngleFromCounts(counts));
 }
 
-std::array<double, kSpoolGrooves> Calibration::CableShorteningFromSpoolAngle(double spool_rad) const {
+std::array<double, kSpoolGrooves> Calibration::CableShorteningFromSpoolAngle(
+    double spool_rad) const {
   std::array<double, kSpoolGrooves> shortening_m{};
   for (size_t i = 0; i < kSpoolGrooves; ++i) shortening_m[i] = spool_groove_radii_m[i] * spool_rad;
   return shortening_m;
 }
 
-std::array<double, kSpoolGrooves> Calibration::PercentLengthChangeFromSpoolAngle(double spool_rad) const {
+std::array<double, kSpoolGrooves> Calibration::PercentLengthChangeFromSpoolAngle(
+    double spool_rad) const {
   const std::array<double, kSpoolGrooves> shortening_m = CableShorteningFromSpoolAngle(spool_rad);
   std::array<double, kSpoolGrooves> percent{};
-  for (size_t i = 0; i < kSpoolGrooves; ++i) percent[i] = -100.0 * shortening_m[i] / cable_lengths_m[i];
+  for (size_t i = 0; i < kSpoolGrooves; ++i)
+    percent[i] = -100.0 * shortening_m[i] / cable_lengths_m[i];
   return percent;
 }
 
@@ -292,7 +302,8 @@ Result<Calibration> CalibrationFromJson(const json& document, const std::string&
     const json* object = root.Raw("notes");
     notes->AcceptAnyKeys();
     if (object != nullptr && object->is_object()) {
-      for (const auto& item : object->items()) calibration.notes[item.key()] = notes->String(item.key());
+      for (const auto& item : object->items())
+        calibration.notes[item.key()] = notes->String(item.key());
     }
   }
 

@@ -140,7 +140,8 @@ std::string JsonReader::Where(std::string_view key) const {
 
 void JsonReader::Fail(std::string_view key, std::string_view message) {
   if (!shared_->first_error.ok()) return;  // the first error is the one worth reading
-  shared_->first_error = Status(StatusCode::kInvalidArgument, Where(key) + ": " + std::string(message));
+  shared_->first_error =
+      Status(StatusCode::kInvalidArgument, Where(key) + ": " + std::string(message));
 }
 
 bool JsonReader::failed() const { return !shared_->first_error.ok(); }
@@ -253,12 +254,14 @@ std::optional<std::vector<JsonReader>> JsonReader::OptionalObjectArray(std::stri
   std::vector<JsonReader> readers;
   readers.reserve(value->size());
   for (size_t i = 0; i < value->size(); ++i) {
-    readers.push_back(JsonReader(&(*value)[i], ChildPointer(key) + "/" + std::to_string(i), shared_));
+    readers.push_back(
+        JsonReader(&(*value)[i], ChildPointer(key) + "/" + std::to_string(i), shared_));
   }
   return readers;
 }
 
-std::optional<std::vector<double>> JsonReader::OptionalNumberArray(std::string_view key, size_t size,
+std::optional<std::vector<double>> JsonReader::OptionalNumberArray(std::string_view key,
+                                                                   size_t size,
                                                                    const NumberRange& range) {
   const json* value = Find(key, true);
   if (value == nullptr) return std::nullopt;
@@ -274,9 +277,9 @@ std::optional<std::vector<double>> JsonReader::OptionalNumberArray(std::string_v
     // the index is a pointer step of its own, not part of an escaped key
     const auto fail_element = [&](const std::string& got) {
       if (!shared_->first_error.ok()) return;
-      shared_->first_error = InvalidArgumentError(
-          shared_->source + ": " + ChildPointer(key) + "/" + std::to_string(i) + ": expected " +
-          DescribeRange(range, false) + ", got " + got);
+      shared_->first_error = InvalidArgumentError(shared_->source + ": " + ChildPointer(key) + "/" +
+                                                  std::to_string(i) + ": expected " +
+                                                  DescribeRange(range, false) + ", got " + got);
     };
     if (!element.is_number()) {
       fail_element(Describe(element));

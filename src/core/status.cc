@@ -33,10 +33,14 @@ Status Status::WithContext(std::string_view context) const {
 Status InvalidArgumentError(std::string message) {
   return Status(StatusCode::kInvalidArgument, std::move(message));
 }
-Status NotFoundError(std::string message) { return Status(StatusCode::kNotFound, std::move(message)); }
+Status NotFoundError(std::string message) {
+  return Status(StatusCode::kNotFound, std::move(message));
+}
 Status ParseError(std::string message) { return Status(StatusCode::kParse, std::move(message)); }
 Status IoError(std::string message) { return Status(StatusCode::kIo, std::move(message)); }
-Status TimeoutError(std::string message) { return Status(StatusCode::kTimeout, std::move(message)); }
+Status TimeoutError(std::string message) {
+  return Status(StatusCode::kTimeout, std::move(message));
+}
 Status UnsupportedError(std::string message) {
   return Status(StatusCode::kUnsupported, std::move(message));
 }

@@ -35,7 +35,8 @@ SimRun ReadRun(JsonReader& reader) {
   run.stood = reader.Boolean("stood");
   run.liftoff_rad = reader.OptionalNumber("liftoff_rad", {.min = 0.0});
   if (!reader.failed() && run.stood && !run.liftoff_rad) {
-    reader.Fail("liftoff_rad", "missing required field (a run that stood needs its liftoff rotation)");
+    reader.Fail("liftoff_rad",
+                "missing required field (a run that stood needs its liftoff rotation)");
   }
   if (auto group = reader.OptionalEnum("pulled_group", kGroupNames)) {
     run.pulled_group = ParseCableGroup(kGroupNames[*group]);
@@ -72,7 +73,8 @@ Result<SimResults> SimResultsFromJson(const json& document, const std::string& s
   const int64_t version = root.Integer("version", {.min = 1});
   if (!root.failed() && version > kFormatVersion) {
     return UnsupportedError(root.Where("version") + ": version " + std::to_string(version) +
-                            " is newer than this liftoff reads (" + std::to_string(kFormatVersion) + ")");
+                            " is newer than this liftoff reads (" + std::to_string(kFormatVersion) +
+                            ")");
   }
   results.model = root.String("model");
   results.description = root.OptionalString("description").value_or("");

@@ -28,7 +28,8 @@ std::string Summary::Brief() const {
   if (n > 1) {
     char level[16];
     std::snprintf(level, sizeof level, "%g", confidence * 100.0);
-    text += ", " + std::string(level) + " % CI [" + Format(ci95_low) + ", " + Format(ci95_high) + "]";
+    text +=
+        ", " + std::string(level) + " % CI [" + Format(ci95_low) + ", " + Format(ci95_high) + "]";
   }
   text += ", range [" + Format(min) + ", " + Format(max) + "]";
   return text;
@@ -61,8 +62,8 @@ Summary Summarize(std::span<const double> values, double confidence) {
 
   summary.min = sorted.front();
   summary.max = sorted.back();
-  summary.median = count % 2 == 1 ? sorted[count / 2]
-                                  : 0.5 * (sorted[count / 2 - 1] + sorted[count / 2]);
+  summary.median =
+      count % 2 == 1 ? sorted[count / 2] : 0.5 * (sorted[count / 2 - 1] + sorted[count / 2]);
   double sum = 0.0;
   for (double value : sorted) sum += value;
   summary.mean = sum / static_cast<double>(count);

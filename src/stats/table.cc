@@ -47,16 +47,19 @@ std::string MarkdownEscape(std::string_view text) {
 // title in bold, the table, the calibration line, then the notes as a list
 // `alignment` has one letter per column: l, r or c
 std::string RenderMarkdown(std::string_view title, std::string_view alignment,
-                           const std::vector<std::string>& header, const std::vector<Row>& rows, std::string_view calibration,
-                           std::string_view lookup_rule, const std::vector<std::string>& notes) {
+                           const std::vector<std::string>& header, const std::vector<Row>& rows,
+                           std::string_view calibration, std::string_view lookup_rule,
+                           const std::vector<std::string>& notes) {
   std::string out = "**" + MarkdownEscape(title) + "**\n\n|";
   for (const std::string& name : header) out += " " + MarkdownEscape(name) + " |";
   out += "\n|";
-  for (char align : alignment) out += align == 'r' ? " ---: |" : align == 'c' ? " :---: |" : " --- |";
+  for (char align : alignment)
+    out += align == 'r' ? " ---: |" : align == 'c' ? " :---: |" : " --- |";
   out += "\n";
   for (const Row& row : rows) {
     out += "|";
-    for (const Cell& cell : row) out += " " + (cell ? MarkdownEscape(*cell) : std::string("–")) + " |";
+    for (const Cell& cell : row)
+      out += " " + (cell ? MarkdownEscape(*cell) : std::string("–")) + " |";
     out += "\n";
   }
   out += "\n" + CalibrationLine(calibration, lookup_rule) + "\n";
@@ -99,7 +102,13 @@ std::string LatexEscape(std::string_view text) {
       case '\\': escaped += "\\textbackslash{}"; break;
       case '~': escaped += "\\textasciitilde{}"; break;
       case '^': escaped += "\\textasciicircum{}"; break;
-      case '&': case '%': case '$': case '#': case '_': case '{': case '}':
+      case '&':
+      case '%':
+      case '$':
+      case '#':
+      case '_':
+      case '{':
+      case '}':
         escaped += '\\';
         escaped += c;
         break;
@@ -110,9 +119,10 @@ std::string LatexEscape(std::string_view text) {
 }
 
 // a booktabs table; `header` is already LaTeX (it may hold rules and \multicolumn)
-std::string RenderLatex(std::string_view title, std::string_view column_spec, std::string_view header,
-                        const std::vector<Row>& rows, std::string_view calibration,
-                        std::string_view lookup_rule, const std::vector<std::string>& notes) {
+std::string RenderLatex(std::string_view title, std::string_view column_spec,
+                        std::string_view header, const std::vector<Row>& rows,
+                        std::string_view calibration, std::string_view lookup_rule,
+                        const std::vector<std::string>& notes) {
   std::string out = "\\begin{table}[htb]\n  \\centering\n  \\caption{" + LatexEscape(title) + ". " +
                     LatexEscape(CalibrationLine(calibration, lookup_rule)) + "}\n";
   out += "  \\begin{tabular}{" + std::string(column_spec) + "}\n    \\toprule\n";
@@ -177,19 +187,22 @@ ResultsTable BuildResultsTable(std::span<const TrialValue> trials, const SimResu
 
   // notes: where the simulation came from, what was left out, what was typed in
   if (sim != nullptr) {
-    std::string note = "Simulation: " + (sim->model.empty() ? std::string("(unnamed model)") : sim->model);
+    std::string note =
+        "Simulation: " + (sim->model.empty() ? std::string("(unnamed model)") : sim->model);
     if (!sim->description.empty()) note += ", " + sim->description;
     table.notes.push_back(note + " (" + sim->source + ").");
     for (const auto& [foot, range] : sim->ranges) {
       if (!range.from_summary) continue;
-      table.notes.push_back("Sim range of foot " + std::string(FootName(foot)) +
-                            " from the results' summary (typed in), not from runs" +
-                            (range.n_runs ? "; " + std::to_string(range.n_runs) + " standing runs listed." : "."));
+      table.notes.push_back(
+          "Sim range of foot " + std::string(FootName(foot)) +
+          " from the results' summary (typed in), not from runs" +
+          (range.n_runs ? "; " + std::to_string(range.n_runs) + " standing runs listed." : "."));
     }
     for (const SimRun& run : sim->runs) {
       if (run.stood) continue;
-      table.notes.push_back("Sim run of foot " + std::string(FootName(run.foot)) + " at tension point " +
-                            run.tension_point + " did not stand; excluded from sim min/max.");
+      table.notes.push_back("Sim run of foot " + std::string(FootName(run.foot)) +
+                            " at tension point " + run.tension_point +
+                            " did not stand; excluded from sim min/max.");
     }
   }
   for (const TrialValue& trial : trials) {
@@ -227,8 +240,10 @@ json ResultsTableToJson(const ResultsTable& table) {
     for (const TrialValue& trial : row.trials) trials.push_back(TrialToJson(trial));
     json sim = nullptr;
     if (row.sim) {
-      sim = {{"min_rad", row.sim->min_rad}, {"max_rad", row.sim->max_rad},
-             {"n_runs", row.sim->n_runs}, {"from_summary", row.sim->from_summary}};
+      sim = {{"min_rad", row.sim->min_rad},
+             {"max_rad", row.sim->max_rad},
+             {"n_runs", row.sim->n_runs},
+             {"from_summary", row.sim->from_summary}};
     }
     rows.push_back({{"foot", FootName(row.foot)},
                     {"sim", std::move(sim)},
@@ -244,9 +259,12 @@ json ResultsTableToJson(const ResultsTable& table) {
                       {"confidence", hw.confidence}}},
                     {"trials", std::move(trials)}});
   }
-  return {{"format", "liftoff-results-table"}, {"version", 1},
-          {"title", table.title},            {"calibration", table.calibration},
-          {"lookup_rule", table.lookup_rule}, {"rows", std::move(rows)},
+  return {{"format", "liftoff-results-table"},
+          {"version", 1},
+          {"title", table.title},
+          {"calibration", table.calibration},
+          {"lookup_rule", table.lookup_rule},
+          {"rows", std::move(rows)},
           {"notes", table.notes}};
 }
 
@@ -261,8 +279,8 @@ std::string RenderResultsTable(const ResultsTable& table, TableFormat format) {
     Row cells = {std::string(FootName(row.foot)), row.sim ? Fixed3(row.sim->min_rad) : std::nullopt,
                  row.sim ? Fixed3(row.sim->max_rad) : std::nullopt};
     if (csv) cells.push_back(row.sim ? Count(row.sim->n_runs) : std::nullopt);
-    for (Cell cell : {Fixed3(hw.min), Fixed3(hw.max), Count(hw.n), Fixed3(hw.mean), Fixed3(hw.stddev),
-                      Fixed3(hw.median)}) {
+    for (Cell cell : {Fixed3(hw.min), Fixed3(hw.max), Count(hw.n), Fixed3(hw.mean),
+                      Fixed3(hw.stddev), Fixed3(hw.median)}) {
       cells.push_back(std::move(cell));
     }
     if (csv) {
@@ -283,17 +301,18 @@ std::string RenderResultsTable(const ResultsTable& table, TableFormat format) {
                              "HW sd", "HW median", "HW 95 % CI of mean"},
                             rows, table.calibration, table.lookup_rule, table.notes);
     case TableFormat::kCsv:
-      return RenderCsv({"foot", "sim_min_rad", "sim_max_rad", "sim_n_runs", "hw_min_rad", "hw_max_rad",
-                        "hw_n", "hw_mean_rad", "hw_sd_rad", "hw_median_rad", "hw_ci95_low_rad",
-                        "hw_ci95_high_rad", "calibration", "lookup_rule"},
+      return RenderCsv({"foot", "sim_min_rad", "sim_max_rad", "sim_n_runs", "hw_min_rad",
+                        "hw_max_rad", "hw_n", "hw_mean_rad", "hw_sd_rad", "hw_median_rad",
+                        "hw_ci95_low_rad", "hw_ci95_high_rad", "calibration", "lookup_rule"},
                        rows);
     case TableFormat::kLatex:
-      return RenderLatex(table.title, kResultsAlignment,
-                         "    & \\multicolumn{2}{c}{Simulation} & \\multicolumn{7}{c}{Hardware} \\\\\n"
-                         "    \\cmidrule(lr){2-3} \\cmidrule(lr){4-10}\n"
-                         "    Foot & Min & Max & Min & Max & $n$ & Mean & SD & Median & "
-                         "95\\,\\% CI of mean \\\\\n",
-                         rows, table.calibration, table.lookup_rule, table.notes);
+      return RenderLatex(
+          table.title, kResultsAlignment,
+          "    & \\multicolumn{2}{c}{Simulation} & \\multicolumn{7}{c}{Hardware} \\\\\n"
+          "    \\cmidrule(lr){2-3} \\cmidrule(lr){4-10}\n"
+          "    Foot & Min & Max & Min & Max & $n$ & Mean & SD & Median & "
+          "95\\,\\% CI of mean \\\\\n",
+          rows, table.calibration, table.lookup_rule, table.notes);
     case TableFormat::kJson: break;
   }
   return "";
@@ -305,9 +324,14 @@ std::string RenderTrialTable(std::span<const TrialValue> trials, TableFormat for
   if (format == TableFormat::kJson) {
     json rows = json::array();
     for (const TrialValue& trial : trials) rows.push_back(TrialToJson(trial));
-    return json({{"format", "liftoff-trial-table"}, {"version", 1}, {"title", title},
-                 {"calibration", calibration}, {"lookup_rule", lookup_rule}, {"trials", std::move(rows)}})
-               .dump(2) + "\n";
+    return json({{"format", "liftoff-trial-table"},
+                 {"version", 1},
+                 {"title", title},
+                 {"calibration", calibration},
+                 {"lookup_rule", lookup_rule},
+                 {"trials", std::move(rows)}})
+               .dump(2) +
+           "\n";
   }
 
   // csv keeps the interval's ends apart and names the calibration on every row
@@ -329,15 +353,17 @@ std::string RenderTrialTable(std::span<const TrialValue> trials, TableFormat for
 
   switch (format) {
     case TableFormat::kMarkdown:
-      return RenderMarkdown(title, kTrialAlignment, {"Trial", "Foot", "Liftoff", "Interval", "Flags"}, rows, calibration,
+      return RenderMarkdown(title, kTrialAlignment,
+                            {"Trial", "Foot", "Liftoff", "Interval", "Flags"}, rows, calibration,
                             lookup_rule, {});
     case TableFormat::kCsv:
       return RenderCsv({"trial_id", "foot", "liftoff_rad", "lower_rad", "upper_rad", "flags",
                         "calibration", "lookup_rule"},
                        rows);
     case TableFormat::kLatex:
-      return RenderLatex(title, kTrialAlignment, "    Trial & Foot & Liftoff & Interval & Flags \\\\\n", rows,
-                         calibration, lookup_rule, {});
+      return RenderLatex(title, kTrialAlignment,
+                         "    Trial & Foot & Liftoff & Interval & Flags \\\\\n", rows, calibration,
+                         lookup_rule, {});
     case TableFormat::kJson: break;
   }
   return "";

@@ -26,9 +26,9 @@ std::string Sec(int64_t ns) { return FormatSeconds(ns, 3) + " s"; }
 double AngleAt(const std::vector<AnglePoint>& points, int64_t time_ns, LookupRule rule) {
   if (time_ns <= points.front().time_ns) return points.front().vertebra_rad;
   if (time_ns >= points.back().time_ns) return points.back().vertebra_rad;
-  const auto after = std::upper_bound(
-      points.begin(), points.end(), time_ns,
-      [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
+  const auto after =
+      std::upper_bound(points.begin(), points.end(), time_ns,
+                       [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
   const AnglePoint& before = *(after - 1);
   if (rule == LookupRule::kSampleAndHold || before.time_ns == time_ns) return before.vertebra_rad;
   const double fraction = static_cast<double>(time_ns - before.time_ns) /
@@ -117,8 +117,8 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   const auto last_sample = std::find_if(log.samples.rbegin(), log.samples.rend(), has_angle);
   const AnglePoint first{first_sample->device_time_ns, first_sample->vertebra_rad};
   const AnglePoint last{last_sample->device_time_ns, last_sample->vertebra_rad};
-  const std::string span = "(log spans " + FormatSeconds(first.time_ns) + "-" +
-                           FormatSeconds(last.time_ns) + " s)";
+  const std::string span =
+      "(log spans " + FormatSeconds(first.time_ns) + "-" + FormatSeconds(last.time_ns) + " s)";
 
   // queries too far outside the log
   const int64_t tolerance_ns = NsFromSeconds(options.max_past_end_s);
@@ -144,9 +144,9 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   lookup.vertebra_rad = AngleAt(points, query_ns, options.rule);
 
   // bracketing samples: last at or before, first at or after
-  const auto at_or_after = std::lower_bound(
-      points.begin(), points.end(), query_ns,
-      [](const AnglePoint& point, int64_t t) { return point.time_ns < t; });
+  const auto at_or_after =
+      std::lower_bound(points.begin(), points.end(), query_ns,
+                       [](const AnglePoint& point, int64_t t) { return point.time_ns < t; });
   if (at_or_after != points.end()) lookup.sample_after_ns = at_or_after->time_ns;
   if (at_or_after != points.end() && at_or_after->time_ns == query_ns) {
     lookup.sample_before_ns = query_ns;
@@ -163,9 +163,9 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
                           AngleAt(points, window_end_ns, options.rule));
   lower = std::min(lower, lookup.vertebra_rad);
   upper = std::max(upper, lookup.vertebra_rad);
-  const auto inside_begin = std::upper_bound(
-      points.begin(), points.end(), window_begin_ns,
-      [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
+  const auto inside_begin =
+      std::upper_bound(points.begin(), points.end(), window_begin_ns,
+                       [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
   auto inside_end = inside_begin;
   for (; inside_end != points.end() && inside_end->time_ns < window_end_ns; ++inside_end) {
     lower = std::min(lower, inside_end->vertebra_rad);
@@ -199,11 +199,10 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
     const std::string where = "a " + FormatSeconds(lookup.gap_ns, 2) +
                               " s gap between samples at " + Sec(gap_before->time_ns) + " and " +
                               Sec(gap_before->time_ns + lookup.gap_ns);
-    lookup.warnings.push_back(
-        query_in_reported_gap
-            ? "instant " + Sec(query_ns) + " is inside " + where
-            : "the window " + FormatSeconds(query_ns) + " +/- " + Sec(query_uncertainty_ns) +
-                  " overlaps " + where);
+    lookup.warnings.push_back(query_in_reported_gap
+                                  ? "instant " + Sec(query_ns) + " is inside " + where
+                                  : "the window " + FormatSeconds(query_ns) + " +/- " +
+                                        Sec(query_uncertainty_ns) + " overlaps " + where);
   }
 
   // past either end: widen by the log's mean rate times the distance outside
@@ -218,17 +217,16 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   lookup.past_end = query_ns > last.time_ns;
   lookup.before_start = query_ns < first.time_ns;
   if (lookup.past_end) {
-    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " +
-                              Sec(query_ns - last.time_ns) + " after the log's last sample at " +
-                              Sec(last.time_ns) + "; its value is held");
+    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " + Sec(query_ns - last.time_ns) +
+                              " after the log's last sample at " + Sec(last.time_ns) +
+                              "; its value is held");
   } else if (after_end_ns > 0) {
     lookup.warnings.push_back("the window " + FormatSeconds(query_ns) + " +/- " +
                               Sec(query_uncertainty_ns) + " reaches " + Sec(after_end_ns) +
                               " past the log's last sample at " + Sec(last.time_ns));
   }
   if (lookup.before_start) {
-    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " +
-                              Sec(first.time_ns - query_ns) +
+    lookup.warnings.push_back("instant " + Sec(query_ns) + " is " + Sec(first.time_ns - query_ns) +
                               " before the log's first sample at " + Sec(first.time_ns) +
                               "; its value is held");
   } else if (before_start_ns > 0) {
@@ -266,8 +264,8 @@ Result<LiftoffMeasurement> MeasureLiftoff(const ControllerLog& log, const EventT
   }
   if (video_times.liftoff_ns < video_times.led_on_ns) {
     return InvalidArgumentError("event times: liftoff at " + Sec(video_times.liftoff_ns) +
-                                " is before the LED switched on at " +
-                                Sec(video_times.led_on_ns) + " (video clock)");
+                                " is before the LED switched on at " + Sec(video_times.led_on_ns) +
+                                " (video clock)");
   }
   LiftoffMeasurement measurement;
   measurement.interval_ns = video_times.liftoff_ns - video_times.led_on_ns;

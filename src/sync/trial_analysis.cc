@@ -6,8 +6,7 @@ namespace liftoff::sync {
 namespace {
 
 // the error with the trial id and, unless it already names it, the file in front
-Status ForTrial(const Status& status, const TrialRecord& trial,
-                const std::filesystem::path& file) {
+Status ForTrial(const Status& status, const TrialRecord& trial, const std::filesystem::path& file) {
   Status located = status;
   if (!file.empty() && status.message().find(file.filename().string()) == std::string::npos) {
     located = status.WithContext(file.string());
@@ -22,15 +21,15 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
   // hand times are the only source of event times for now
   if (!trial.times) {
     if (trial.video_path) {
-      return ForTrial(UnsupportedError(
-                          "automatic video analysis is not available yet; give hand times"),
-                      trial, *trial.video_path);
+      return ForTrial(
+          UnsupportedError("automatic video analysis is not available yet; give hand times"), trial,
+          *trial.video_path);
     }
     const std::filesystem::path manifest_name =
         manifest.source_path.empty() ? std::filesystem::path("manifest") : manifest.source_path;
-    return ForTrial(InvalidArgumentError(
-                          "the trial has neither event times nor a video; give hand times"),
-                    trial, manifest_name);
+    return ForTrial(
+        InvalidArgumentError("the trial has neither event times nor a video; give hand times"),
+        trial, manifest_name);
   }
 
   // the log, then the angle at liftoff on it
@@ -91,9 +90,8 @@ ManifestAnalysis AnalyzeManifest(const TrialManifest& manifest, const Calibratio
     TrialOutcome outcome;
     outcome.trial = trial;
     // bad options fail every trial alike; otherwise each trial stands alone
-    outcome.status = options_status.ok()
-                         ? AnalyzeTrial(manifest, calibration, options, outcome)
-                         : options_status.WithContext(trial.id);
+    outcome.status = options_status.ok() ? AnalyzeTrial(manifest, calibration, options, outcome)
+                                         : options_status.WithContext(trial.id);
     if (!outcome.status.ok()) ++analysis.failed;
     analysis.outcomes.push_back(std::move(outcome));
   }

@@ -20,14 +20,14 @@ using ::liftoff::testing::ScratchDir;
 using ::liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
 
-
 // ---------------------------------------------------------------------------------------
 // ImportLaika2018Log on small synthetic files
 
 TEST(Laika2018Log, ReadsBareCrLinesWithTrailingCommas) {
   ScratchDir dir;
   WriteFile(dir / "Test1 Front Right Blue.txt", "4,-0.01,\r13,-0.02,\r1074,-0.40,\r");
-  const auto log = ImportLaika2018Log(dir / "Test1 Front Right Blue.txt", liftoff::testing::DriveChainCalibration());
+  const auto log = ImportLaika2018Log(dir / "Test1 Front Right Blue.txt",
+                                      liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[0].device_time_ns, 4'000'000);
@@ -81,7 +81,8 @@ TEST(Laika2018Log, ReadsLfLinesWithoutTrailingComma) {
 TEST(Laika2018Log, ParsesFractionalMillisecondsExactly) {
   ScratchDir dir;
   WriteFile(dir / "fraction.txt", "1074.33,0.1,\r");
-  const auto log = ImportLaika2018Log(dir / "fraction.txt", liftoff::testing::DriveChainCalibration());
+  const auto log =
+      ImportLaika2018Log(dir / "fraction.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->samples[0].device_time_ns, 1'074'330'000);
 }
@@ -123,7 +124,8 @@ TEST(Laika2018Log, UnendedLastLineMissingItsTrailingCommaMayHaveLostDigits) {
   EXPECT_TRUE(log->report.truncated_last_line);
   // an unended last line that is complete is kept
   WriteFile(dir / "whole.txt", "1,0.5,\r2,0.6,\r3,0.8,");
-  const auto whole = ImportLaika2018Log(dir / "whole.txt", liftoff::testing::DriveChainCalibration());
+  const auto whole =
+      ImportLaika2018Log(dir / "whole.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(whole.ok()) << whole.status().ToString();
   EXPECT_EQ(whole->samples.size(), 3u);
   EXPECT_FALSE(whole->report.truncated_last_line);
@@ -144,7 +146,8 @@ TEST(Laika2018Log, GarbageMiddleLineIsAnErrorNamingFileAndLine) {
 TEST(Laika2018Log, GarbageMiddleLineIsToleratedWithMaxBadLines) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "1,0.1,\r2,0.2,\rmotor fault\r4,0.4,\r");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 1});
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(),
+                                      {.max_bad_lines = 1});
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[2].device_time_ns, 4'000'000);
@@ -159,11 +162,14 @@ TEST(Laika2018Log, GarbageMiddleLineIsToleratedWithMaxBadLines) {
 TEST(Laika2018Log, MoreBadLinesThanAllowedNamesTheFirstAndTheCount) {
   ScratchDir dir;
   WriteFile(dir / "bad.txt", "1,0.1,\r2,,\r3,0.3,\rabc\r,0.5,\r6,0.6,\r");
-  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 2});
+  const auto log = ImportLaika2018Log(dir / "bad.txt", liftoff::testing::DriveChainCalibration(),
+                                      {.max_bad_lines = 2});
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kParse);
   EXPECT_THAT(log.status().message(), HasSubstr("bad.txt:2: expected `t_ms,value,`, got \"2,,\""));
-  EXPECT_THAT(log.status().message(), HasSubstr("(3 bad lines in all, not counting a truncated last line; at most 2 allowed)"));
+  EXPECT_THAT(
+      log.status().message(),
+      HasSubstr("(3 bad lines in all, not counting a truncated last line; at most 2 allowed)"));
 }
 
 TEST(Laika2018Log, KeepsOnlyTheFirstIssuesButCountsAll) {
@@ -201,7 +207,8 @@ TEST(Laika2018Log, FileOfOnlyATruncatedLineHasNoSamples) {
 
 TEST(Laika2018Log, MissingFileIsNotFound) {
   ScratchDir dir;
-  const auto log = ImportLaika2018Log(dir / "absent.txt", liftoff::testing::DriveChainCalibration());
+  const auto log =
+      ImportLaika2018Log(dir / "absent.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kNotFound);
   EXPECT_THAT(log.status().message(), HasSubstr("absent.txt"));
@@ -210,7 +217,8 @@ TEST(Laika2018Log, MissingFileIsNotFound) {
 TEST(Laika2018Log, NonIncreasingTimeIsDroppedAndCounted) {
   ScratchDir dir;
   WriteFile(dir / "order.txt", "1,0.1,\r5,0.2,\r4,0.3,\r5,0.4,\r6,0.5,\r");
-  const auto log = ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = 2});
+  const auto log = ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration(),
+                                      {.max_bad_lines = 2});
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_EQ(log->samples[1].device_time_ns, 5'000'000);
@@ -222,16 +230,20 @@ TEST(Laika2018Log, NonIncreasingTimeIsDroppedAndCounted) {
   EXPECT_EQ(log->report.issues[0].line, 3);
   EXPECT_EQ(log->report.issues[1].line, 4);
 
-  const auto strict = ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration());
+  const auto strict =
+      ImportLaika2018Log(dir / "order.txt", liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(strict.ok());
   EXPECT_EQ(strict.status().code(), StatusCode::kParse);
-  EXPECT_THAT(strict.status().message(), HasSubstr("order.txt:3: t_ms: expected more than the previous sample's 5, got \"4\""));
+  EXPECT_THAT(
+      strict.status().message(),
+      HasSubstr("order.txt:3: t_ms: expected more than the previous sample's 5, got \"4\""));
 }
 
 TEST(Laika2018Log, InvalidOptionsAreRejected) {
   ScratchDir dir;
   WriteFile(dir / "ok.txt", "1,0.1,\r");
-  const auto log = ImportLaika2018Log(dir / "ok.txt", liftoff::testing::DriveChainCalibration(), {.max_bad_lines = -1});
+  const auto log = ImportLaika2018Log(dir / "ok.txt", liftoff::testing::DriveChainCalibration(),
+                                      {.max_bad_lines = -1});
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(log.status().message(), HasSubstr("max_bad_lines"));
@@ -243,7 +255,8 @@ TEST(Laika2018Log, InvalidOptionsAreRejected) {
 TEST(LoadControllerLog, DispatchesLaika2018ToTheImporter) {
   ScratchDir dir;
   WriteFile(dir / "old.txt", "10,2.0,\r");
-  const auto log = LoadControllerLog(dir / "old.txt", LogFormat::kLaika2018, liftoff::testing::DriveChainCalibration());
+  const auto log = LoadControllerLog(dir / "old.txt", LogFormat::kLaika2018,
+                                     liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   EXPECT_EQ(log->report.format, "laika-2018");
   EXPECT_DOUBLE_EQ(log->samples[0].vertebra_rad, 0.5);
@@ -272,7 +285,8 @@ TEST(LoadControllerLog, FillsAnglesOfALiftoffLogFromCounts) {
   complete.bend_spool_rad = 0.5;
   ASSERT_TRUE(WriteControllerLog(dir / "new.log", written).ok());
 
-  const auto log = LoadControllerLog(dir / "new.log", LogFormat::kLiftoff, liftoff::testing::DriveChainCalibration());
+  const auto log = LoadControllerLog(dir / "new.log", LogFormat::kLiftoff,
+                                     liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(log.ok()) << log.status().ToString();
   ASSERT_EQ(log->samples.size(), 3u);
   EXPECT_NEAR(log->samples[0].rotate_shaft_rad, 2 * std::numbers::pi, 1e-12);
@@ -288,13 +302,15 @@ TEST(LoadControllerLog, FillsAnglesOfALiftoffLogFromCounts) {
 TEST(LoadControllerLog, ErrorsNameTheFile) {
   ScratchDir dir;
   for (LogFormat format : {LogFormat::kLiftoff, LogFormat::kLaika2018}) {
-    const auto log = LoadControllerLog(dir / "nowhere.log", format, liftoff::testing::DriveChainCalibration());
+    const auto log =
+        LoadControllerLog(dir / "nowhere.log", format, liftoff::testing::DriveChainCalibration());
     ASSERT_FALSE(log.ok());
     EXPECT_EQ(log.status().code(), StatusCode::kNotFound);
     EXPECT_THAT(log.status().message(), HasSubstr("nowhere.log"));
   }
   WriteFile(dir / "garbage.log", "this is not a log\n");
-  const auto log = LoadControllerLog(dir / "garbage.log", LogFormat::kLiftoff, liftoff::testing::DriveChainCalibration());
+  const auto log = LoadControllerLog(dir / "garbage.log", LogFormat::kLiftoff,
+                                     liftoff::testing::DriveChainCalibration());
   ASSERT_FALSE(log.ok());
   EXPECT_THAT(log.status().message(), HasSubstr("garbage.log"));
 }
@@ -393,7 +409,8 @@ TEST(Laika2018Folder, ManifestWrittenAtItsPathHasRelativeLogsAndLoadsBack) {
 
 TEST(Laika2018Folder, MapsBackFeetToTheLeftGroupPerTableTwo) {
   ScratchDir dir;
-  WriteFile(dir / kLaika2018TimesCsv, std::string(kCsvHeader) + "C,3,8.09,17.1,9.01\nD,4,8.34,15.5,7.16\n");
+  WriteFile(dir / kLaika2018TimesCsv,
+            std::string(kCsvHeader) + "C,3,8.09,17.1,9.01\nD,4,8.34,15.5,7.16\n");
   WriteFile(dir / "Test3 Back Right Purple.txt", "1,0.1,\r");
   WriteFile(dir / "Test4 Back Left Red.txt", "1,0.1,\r");
   const auto imported = ImportLaika2018Folder(dir.path(), dir / "trials.json");
@@ -458,10 +475,12 @@ TEST(Laika2018Folder, MalformedRowsAreErrorsNamingCsvLineAndColumn) {
   const std::vector<Case> cases = {
       {"A,1,5.67,11.8,6.13\nE,1,5.67,11.8,6.13\n",
        "videos.csv:5: column 1 (foot): expected one of A, B, C, D, got \"E\""},
-      {"A,x,5.67,11.8,6.13\n", "videos.csv:4: column 2 (test): expected an integer >= 1, got \"x\""},
+      {"A,x,5.67,11.8,6.13\n",
+       "videos.csv:4: column 2 (test): expected an integer >= 1, got \"x\""},
       {"A,1,5,67,11.8,6.13\n", "videos.csv:4: expected `foot,test,"},
       {"A,1,5.67s,11.8,6.13\n", "videos.csv:4: column 3 (LED-on time): expected a non-negative"},
-      {"A,1,11.8,5.67,-6.13\n", "videos.csv:4: liftoff time 5.67 s is not after LED-on time 11.8 s"},
+      {"A,1,11.8,5.67,-6.13\n",
+       "videos.csv:4: liftoff time 5.67 s is not after LED-on time 11.8 s"},
       {"A,1,5.67,11.8,6.13\nA,1,5.68,11.8,6.12\n",
        "videos.csv:5: a second row for A1 (the first is at line 4)"},
       {"", "videos.csv: no rows"},
@@ -508,9 +527,9 @@ TEST(Laika2018Reference, AllTwentyLogsImportWithOnlyTruncatedLastLinesSkipped) {
   EXPECT_EQ(files, 20);
   // every front-left and back-right log ends in a stray number such as "1074.33"
   const std::set<std::string> expected_truncated = {
-      "Test1 Back Right Purple.txt",  "Test2 Back Right Purple.txt",  "Test3 Back Right Purple.txt",
-      "Test4 Back Right Purple.txt",  "Test5 Back Right Purple.txt",  "Test1 Front Left Orange.txt",
-      "Test2 Front Left Orange.txt",  "Test3 Front Left Orange.txt",  "Test4 Front Left Orange.txt",
+      "Test1 Back Right Purple.txt", "Test2 Back Right Purple.txt", "Test3 Back Right Purple.txt",
+      "Test4 Back Right Purple.txt", "Test5 Back Right Purple.txt", "Test1 Front Left Orange.txt",
+      "Test2 Front Left Orange.txt", "Test3 Front Left Orange.txt", "Test4 Front Left Orange.txt",
       "Test5 Front Left Orange.txt"};
   EXPECT_EQ(truncated, expected_truncated);
 }
@@ -519,7 +538,8 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   LIFTOFF_REQUIRE_REFERENCE(ref);
   const auto folder = ref / "laika-2018-hardware";
   // counted with `tr '\r' '\n' | grep -c` and read with `od -c`
-  const auto front_left = ImportLaika2018Log(folder / "Test1 Front Left Orange.txt", liftoff::testing::DriveChainCalibration());
+  const auto front_left = ImportLaika2018Log(folder / "Test1 Front Left Orange.txt",
+                                             liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(front_left.ok()) << front_left.status().ToString();
   EXPECT_EQ(front_left->samples.size(), 169u);
   EXPECT_EQ(front_left->samples.front().device_time_ns, 10'000'000);
@@ -531,7 +551,8 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   EXPECT_THAT(front_left->report.issues[0].reason, HasSubstr("\"1074.33\""));
 
   // the one CR LF file
-  const auto crlf = ImportLaika2018Log(folder / "Test3 Back Left Red.txt", liftoff::testing::DriveChainCalibration());
+  const auto crlf = ImportLaika2018Log(folder / "Test3 Back Left Red.txt",
+                                       liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(crlf.ok()) << crlf.status().ToString();
   EXPECT_EQ(crlf->samples.size(), 152u);
   EXPECT_EQ(crlf->report.lines_total, 152);
@@ -539,7 +560,8 @@ TEST(Laika2018Reference, LogsMatchTheirFirstAndLastLines) {
   EXPECT_EQ(crlf->samples.back().device_time_ns, 8'078'000'000);
   EXPECT_DOUBLE_EQ(crlf->samples.back().rotate_shaft_rad, -1.83);
 
-  const auto back_left = ImportLaika2018Log(folder / "Test1 Back Left Red.txt", liftoff::testing::DriveChainCalibration());
+  const auto back_left = ImportLaika2018Log(folder / "Test1 Back Left Red.txt",
+                                            liftoff::testing::DriveChainCalibration());
   ASSERT_TRUE(back_left.ok()) << back_left.status().ToString();
   EXPECT_EQ(back_left->samples.size(), 187u);
   EXPECT_EQ(back_left->samples.back().device_time_ns, 10'073'000'000);
@@ -590,7 +612,8 @@ TEST(Laika2018Reference, AuthorsLookupReproducesTheDocumentedAngles) {
   ASSERT_EQ(imported->manifest.trials.size(), expected_rad.size());
   for (size_t i = 0; i < expected_rad.size(); ++i) {
     const TrialRecord& trial = imported->manifest.trials[i];
-    const auto log = LoadControllerLog(trial.log_path, trial.log_format, liftoff::testing::DriveChainCalibration());
+    const auto log = LoadControllerLog(trial.log_path, trial.log_format,
+                                       liftoff::testing::DriveChainCalibration());
     ASSERT_TRUE(log.ok()) << log.status().ToString();
     const int64_t since_led_ns = trial.times->liftoff_ns - trial.times->led_on_ns;
     const auto after = std::upper_bound(

@@ -1,9 +1,9 @@
 // The command line end to end: the sample data's known answers, the 2018 reference
 // values, and every kind of bad input giving a clear message and its own exit code.
-#include <array>
-#include <map>
 #include <sys/wait.h>
+#include <array>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -18,11 +18,11 @@
 namespace liftoff::cli {
 namespace {
 
-using ::testing::HasSubstr;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::SourceDir;
 using liftoff::testing::WriteFile;
+using ::testing::HasSubstr;
 
 struct CommandRun {
   int code = -1;
@@ -59,14 +59,13 @@ std::string Quoted(const std::filesystem::path& path) { return "\"" + path.strin
 std::filesystem::path WriteOneTrial(const ScratchDir& scratch, const std::string& log_text,
                                     double led_on_s, double liftoff_s) {
   WriteFile(scratch / "trial.txt", log_text);
-  nlohmann::json manifest = {
-      {"format", "liftoff-manifest"},
-      {"version", 1},
-      {"trials",
-       {{{"id", "T1"},
-         {"foot", "A"},
-         {"log", {{"path", "trial.txt"}, {"format", "laika-2018"}}},
-         {"times", {{"led_on_s", led_on_s}, {"liftoff_s", liftoff_s}}}}}}};
+  nlohmann::json manifest = {{"format", "liftoff-manifest"},
+                             {"version", 1},
+                             {"trials",
+                              {{{"id", "T1"},
+                                {"foot", "A"},
+                                {"log", {{"path", "trial.txt"}, {"format", "laika-2018"}}},
+                                {"times", {{"led_on_s", led_on_s}, {"liftoff_s", liftoff_s}}}}}}};
   WriteFile(scratch / "manifest.json", manifest.dump(2));
   return scratch / "manifest.json";
 }
@@ -200,14 +199,17 @@ TEST(CliTable, UnknownCalibrationKeyNamesTheJsonPath) {
 TEST(CliTable, OneBadTrialDoesNotLoseTheOthers) {
   ScratchDir scratch;
   WriteFile(scratch / "good.txt", RampLog2018(5000));
-  nlohmann::json manifest = {
-      {"format", "liftoff-manifest"},
-      {"version", 1},
-      {"trials",
-       {{{"id", "good"}, {"foot", "A"}, {"log", {{"path", "good.txt"}, {"format", "laika-2018"}}},
-         {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}},
-        {{"id", "lost"}, {"foot", "B"}, {"log", {{"path", "missing.txt"}, {"format", "laika-2018"}}},
-         {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}}}}};
+  nlohmann::json manifest = {{"format", "liftoff-manifest"},
+                             {"version", 1},
+                             {"trials",
+                              {{{"id", "good"},
+                                {"foot", "A"},
+                                {"log", {{"path", "good.txt"}, {"format", "laika-2018"}}},
+                                {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}},
+                               {{"id", "lost"},
+                                {"foot", "B"},
+                                {"log", {{"path", "missing.txt"}, {"format", "laika-2018"}}},
+                                {"times", {{"led_on_s", 1.0}, {"liftoff_s", 3.0}}}}}}};
   WriteFile(scratch / "manifest.json", manifest.dump());
   TableCommand command;
   command.manifest_path = scratch / "manifest.json";
@@ -252,9 +254,9 @@ TEST(CliBinary, CalibAndLogCommands) {
   EXPECT_EQ(calib.code, 0) << calib.err;
   EXPECT_THAT(calib.out, HasSubstr("48000 per vertebra revolution"));
   WriteFile(scratch / "ramp.txt", RampLog2018(3000));
-  const CommandRun log = RunBinary("log " + Quoted(scratch / "ramp.txt") + " --convert " +
-                                Quoted(scratch / "ramp.csv"),
-                            scratch);
+  const CommandRun log = RunBinary(
+      "log " + Quoted(scratch / "ramp.txt") + " --convert " + Quoted(scratch / "ramp.csv"),
+      scratch);
   EXPECT_EQ(log.code, 0) << log.err;
   EXPECT_THAT(log.out, HasSubstr("samples: 31"));
   // the converted log reads back as liftoff's format with the same samples
@@ -286,8 +288,8 @@ TEST(CliSync, OneLookupHoldVersusLinear) {
 
 TEST(Samples, RegenerateByteForByte) {
   ScratchDir scratch;
-  const std::string command = std::string("\"") + SAMPLE_GENERATOR + "\" " +
-                              Quoted(scratch / "trials") + " >/dev/null";
+  const std::string command =
+      std::string("\"") + SAMPLE_GENERATOR + "\" " + Quoted(scratch / "trials") + " >/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   const std::filesystem::path committed = SourceDir() / "samples" / "trials";
   int compared = 0;

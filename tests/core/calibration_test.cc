@@ -18,13 +18,15 @@ namespace {
 
 using ::liftoff::testing::ScratchDir;
 using ::liftoff::testing::WriteFile;
+using nlohmann::json;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-using nlohmann::json;
 
 constexpr double kPi = std::numbers::pi;
 
-std::filesystem::path ShippedPath() { return liftoff::testing::SourceDir() / "calib" / "laika-2018.json"; }
+std::filesystem::path ShippedPath() {
+  return liftoff::testing::SourceDir() / "calib" / "laika-2018.json";
+}
 
 // Round numbers for hand computation: 12 counts per rotor turn, 1000:1, 4:1, grooves of
 // 1, 1, 2 and 3 cm on cables of 10 cm.
@@ -161,8 +163,8 @@ TEST(Laika2018Calibration, LoadsAndValidates) {
 
 TEST(Laika2018Calibration, HasThePapersDriveChain) {
   const Calibration calibration = LoadCalibration(ShippedPath()).value();
-  EXPECT_EQ(calibration.gearbox_ratio, 1000);  // paper: 1000:1 gearbox
-  EXPECT_EQ(calibration.spur_gear_ratio, 4);   // paper: 4:1 spur gear pair
+  EXPECT_EQ(calibration.gearbox_ratio, 1000);               // paper: 1000:1 gearbox
+  EXPECT_EQ(calibration.spur_gear_ratio, 4);                // paper: 4:1 spur gear pair
   EXPECT_EQ(calibration.encoder_counts_per_motor_rev, 12);  // assumed
   // the 2018 authors' rule: vertebra angle = 0.25 x logged shaft angle
   EXPECT_DOUBLE_EQ(calibration.VertebraAngleFromShaftAngle(1.84), 0.46);
@@ -298,7 +300,8 @@ TEST(CalibrationFile, MissingFileIsNotFoundNamingIt) {
 
 TEST(CalibrationFile, SyntaxErrorNamesFileAndLine) {
   ScratchDir dir;
-  WriteFile(dir / "broken.json", "{\n  \"format\": \"liftoff-calibration\",\n  \"version\": 1\n  \"name\": \"x\"\n}\n");
+  WriteFile(dir / "broken.json",
+            "{\n  \"format\": \"liftoff-calibration\",\n  \"version\": 1\n  \"name\": \"x\"\n}\n");
   const Result<Calibration> calibration = LoadCalibration(dir / "broken.json");
   ASSERT_FALSE(calibration.ok());
   EXPECT_EQ(calibration.status().code(), StatusCode::kParse);
@@ -312,13 +315,15 @@ TEST(CalibrationFile, UnknownKeyNamesFileAndPointer) {
   ASSERT_TRUE(WriteJsonFile(dir / "typo.json", document).ok());
   const Status status = LoadCalibration(dir / "typo.json").status();
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-  EXPECT_THAT(status.message(), StartsWith((dir / "typo.json").string() + ": /motor/gear_ratio: unknown key"));
+  EXPECT_THAT(status.message(),
+              StartsWith((dir / "typo.json").string() + ": /motor/gear_ratio: unknown key"));
 }
 
 TEST(CalibrationFile, UnknownTopLevelKeyIsRejected) {
   json document = ShippedJson();
   document["spur_ratio"] = 4;
-  EXPECT_THAT(FromJsonStatus(document).message(), StartsWith("calib.json: /spur_ratio: unknown key"));
+  EXPECT_THAT(FromJsonStatus(document).message(),
+              StartsWith("calib.json: /spur_ratio: unknown key"));
 }
 
 TEST(CalibrationFile, NegativeGearboxRatioNamesPointerAndRange) {
@@ -355,8 +360,9 @@ TEST(CalibrationFile, MissingFieldNamesPointer) {
 TEST(CalibrationFile, GrooveRadiiNeedFourEntries) {
   json document = ShippedJson();
   document["bending_spool"]["groove_radii_m"] = {0.004, 0.004, 0.008};
-  EXPECT_THAT(FromJsonStatus(document).message(),
-              StartsWith("calib.json: /bending_spool/groove_radii_m: expected an array of 4 numbers"));
+  EXPECT_THAT(
+      FromJsonStatus(document).message(),
+      StartsWith("calib.json: /bending_spool/groove_radii_m: expected an array of 4 numbers"));
 }
 
 TEST(CalibrationFile, GrooveRadiusInMillimetresIsCaught) {
@@ -409,8 +415,9 @@ TEST(CalibrationFile, NewerVersionIsUnsupported) {
 TEST(CalibrationFile, NoteAboutAnUnknownFieldIsRejected) {
   json document = ShippedJson();
   document["notes"]["/motor/gear_ratio"] = "paper";
-  EXPECT_THAT(FromJsonStatus(document).message(),
-              StartsWith("calib.json: /notes/~1motor~1gear_ratio: expected the JSON pointer of a field"));
+  EXPECT_THAT(
+      FromJsonStatus(document).message(),
+      StartsWith("calib.json: /notes/~1motor~1gear_ratio: expected the JSON pointer of a field"));
 }
 
 TEST(CalibrationFile, NoteMustBeText) {
@@ -435,7 +442,8 @@ TEST(CalibrationValidate, EmptyCalibrationNamesTheFirstBadField) {
 TEST(CalibrationValidate, RejectsNonFiniteValues) {
   Calibration calibration = RoundCalibration();
   calibration.spur_gear_ratio = std::numeric_limits<double>::infinity();
-  EXPECT_THAT(calibration.Validate().message(), StartsWith("/rotating_vertebra/spur_gear_ratio: expected a number > 0"));
+  EXPECT_THAT(calibration.Validate().message(),
+              StartsWith("/rotating_vertebra/spur_gear_ratio: expected a number > 0"));
   calibration = RoundCalibration();
   calibration.cable_lengths_m[1] = std::nan("");
   EXPECT_THAT(calibration.Validate().message(), StartsWith("/bending_spool/cable_lengths_m/1:"));
@@ -467,10 +475,12 @@ TEST(CalibrationValidate, NeedsTensionPointsAndMaterials) {
 TEST(CalibrationValidate, RejectsNoteThatIsNotAPointer) {
   Calibration calibration = RoundCalibration();
   calibration.notes["gearbox_ratio"] = "paper";
-  EXPECT_THAT(calibration.Validate().message(), StartsWith("/notes/gearbox_ratio: expected the JSON pointer"));
+  EXPECT_THAT(calibration.Validate().message(),
+              StartsWith("/notes/gearbox_ratio: expected the JSON pointer"));
   calibration.notes.clear();
   calibration.notes["/motor/gearbox_ratio"] = "";
-  EXPECT_EQ(calibration.Validate().message(), "/notes/~1motor~1gearbox_ratio: expected a non-empty note");
+  EXPECT_EQ(calibration.Validate().message(),
+            "/notes/~1motor~1gearbox_ratio: expected a non-empty note");
 }
 
 }  // namespace

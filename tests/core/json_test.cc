@@ -15,9 +15,9 @@ namespace {
 using ::liftoff::testing::ReadFile;
 using ::liftoff::testing::ScratchDir;
 using ::liftoff::testing::WriteFile;
+using nlohmann::json;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-using nlohmann::json;
 
 // --- files ---------------------------------------------------------------------------
 
@@ -319,11 +319,13 @@ TEST(JsonReader, OptionalFieldStillCheckedWhenPresent) {
 }
 
 TEST(JsonReader, NumberArrayChecksLengthAndElements) {
-  const json document = json::parse(R"({"three": [1, 2, 3], "bad": [0.1, -1, 2], "text": [1, "x"]})");
+  const json document =
+      json::parse(R"({"three": [1, 2, 3], "bad": [0.1, -1, 2], "text": [1, "x"]})");
   {
     JsonReader root(document, "a.json");
     root.NumberArray("three", 4);
-    EXPECT_EQ(root.Finish().message(), "a.json: /three: expected an array of 4 numbers, got [1,2,3]");
+    EXPECT_EQ(root.Finish().message(),
+              "a.json: /three: expected an array of 4 numbers, got [1,2,3]");
   }
   {
     JsonReader root(document, "a.json");
@@ -373,7 +375,8 @@ TEST(JsonReader, FailRecordsCustomErrorsAtPointer) {
 }
 
 TEST(JsonReader, DescribesLongValuesShortly) {
-  const json document = json::parse(R"({"name": [1111111111, 2222222222, 3333333333, 4444444444]})");
+  const json document =
+      json::parse(R"({"name": [1111111111, 2222222222, 3333333333, 4444444444]})");
   JsonReader root(document, "d.json");
   root.String("name");
   const std::string message = root.Finish().message();

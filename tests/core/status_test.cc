@@ -35,9 +35,9 @@ TEST(Status, CodeNamesAreDistinctAndReadable) {
   EXPECT_EQ(StatusCodeName(StatusCode::kInvalidArgument), "invalid argument");
   EXPECT_EQ(StatusCodeName(StatusCode::kNotFound), "not found");
   std::set<std::string_view> names;
-  for (StatusCode code : {StatusCode::kOk, StatusCode::kInvalidArgument, StatusCode::kNotFound,
-                          StatusCode::kParse, StatusCode::kIo, StatusCode::kTimeout,
-                          StatusCode::kUnsupported, StatusCode::kOutOfRange}) {
+  for (StatusCode code :
+       {StatusCode::kOk, StatusCode::kInvalidArgument, StatusCode::kNotFound, StatusCode::kParse,
+        StatusCode::kIo, StatusCode::kTimeout, StatusCode::kUnsupported, StatusCode::kOutOfRange}) {
     EXPECT_FALSE(StatusCodeName(code).empty());
     names.insert(StatusCodeName(code));
   }

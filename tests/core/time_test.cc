@@ -107,9 +107,8 @@ TEST(FormatSeconds, PrintsRequestedDecimals) {
 }
 
 TEST(ClockMap, UnitScaleShiftsOriginsExactly) {
-  const ClockMap log_from_video{.source_origin_ns = 1'000'000'000,
-                                .target_at_origin_ns = 5'000'000'000,
-                                .scale = 1.0};
+  const ClockMap log_from_video{
+      .source_origin_ns = 1'000'000'000, .target_at_origin_ns = 5'000'000'000, .scale = 1.0};
   EXPECT_EQ(log_from_video(1'000'000'000), 5'000'000'000);
   EXPECT_EQ(log_from_video(1'500'000'007), 5'500'000'007);
   EXPECT_EQ(log_from_video(0), 4'000'000'000);
@@ -118,9 +117,8 @@ TEST(ClockMap, UnitScaleShiftsOriginsExactly) {
 }
 
 TEST(ClockMap, ScaleStretchesDurationsAboutTheOrigin) {
-  const ClockMap target_from_source{.source_origin_ns = 2'000'000'000,
-                                    .target_at_origin_ns = 0,
-                                    .scale = 1.001};
+  const ClockMap target_from_source{
+      .source_origin_ns = 2'000'000'000, .target_at_origin_ns = 0, .scale = 1.001};
   EXPECT_EQ(target_from_source(2'000'000'000), 0);
   EXPECT_EQ(target_from_source(3'000'000'000), 1'001'000'000);
   EXPECT_EQ(target_from_source(1'000'000'000), -1'001'000'000);
@@ -129,7 +127,7 @@ TEST(ClockMap, ScaleStretchesDurationsAboutTheOrigin) {
 
 TEST(ClockMap, RoundsMappedDurationsHalfAwayFromZero) {
   const ClockMap map{.source_origin_ns = 0, .target_at_origin_ns = 0, .scale = 1.5};
-  EXPECT_EQ(map.MapDuration(3), 5);   // 4.5
+  EXPECT_EQ(map.MapDuration(3), 5);  // 4.5
   EXPECT_EQ(map.MapDuration(-3), -5);
   EXPECT_EQ(map.MapDuration(2), 3);
 }

@@ -119,8 +119,9 @@ TEST(Summarize, SkipsNonFiniteValues) {
 
 TEST(Summary, BriefNamesCountMeanSpreadAndInterval) {
   const std::string brief = Summarize(kFootA2018).Brief();
-  EXPECT_EQ(brief,
-            "n 5, mean 0.4468, sd 0.0428, median 0.455, 95 % CI [0.3937, 0.4999], range [0.385, 0.502]");
+  EXPECT_EQ(
+      brief,
+      "n 5, mean 0.4468, sd 0.0428, median 0.455, 95 % CI [0.3937, 0.4999], range [0.385, 0.502]");
 }
 
 TEST(Summary, BriefOfOneValueLeavesOutSpread) {

@@ -15,8 +15,8 @@
 namespace liftoff::stats {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -37,11 +37,13 @@ Status LoadError(const std::string& text) {
   return results.status();
 }
 
-constexpr const char* kHeader = R"("format": "liftoff-sim-results", "version": 1, "model": "laika-ntrt")";
+constexpr const char* kHeader =
+    R"("format": "liftoff-sim-results", "version": 1, "model": "laika-ntrt")";
 
 TEST(SimResults, RangesComeFromStandingRunsOnly) {
   testing::ScratchDir dir;
-  auto results = LoadText(dir, std::string("{") + kHeader + R"(, "description": "five tension points",
+  auto results =
+      LoadText(dir, std::string("{") + kHeader + R"(, "description": "five tension points",
     "runs": [
       {"foot": "A", "tension_point": "high", "liftoff_rad": 0.47, "stood": true, "pulled_group": "HR", "rotation": "+"},
       {"foot": "A", "tension_point": "low", "liftoff_rad": 0.33, "stood": true},
@@ -146,15 +148,18 @@ TEST(SimResults, BadFootNamesItsPointer) {
 }
 
 TEST(SimResults, NegativeLiftoffNamesItsPointer) {
-  const Status status = LoadError(std::string("{") + kHeader +
-                                  R"(, "runs": [{"foot": "A", "tension_point": "high", "liftoff_rad": -0.1, "stood": true}]})");
+  const Status status = LoadError(
+      std::string("{") + kHeader +
+      R"(, "runs": [{"foot": "A", "tension_point": "high", "liftoff_rad": -0.1, "stood": true}]})");
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-  EXPECT_THAT(status.message(), HasSubstr("sim.json: /runs/0/liftoff_rad: expected a number >= 0, got -0.1"));
+  EXPECT_THAT(status.message(),
+              HasSubstr("sim.json: /runs/0/liftoff_rad: expected a number >= 0, got -0.1"));
 }
 
 TEST(SimResults, UnknownKeyNamesItsPointer) {
-  const Status status = LoadError(std::string("{") + kHeader +
-                                  R"(, "runs": [{"foot": "A", "tension_point": "high", "liftof_rad": 0.4, "liftoff_rad": 0.4, "stood": true}]})");
+  const Status status = LoadError(
+      std::string("{") + kHeader +
+      R"(, "runs": [{"foot": "A", "tension_point": "high", "liftof_rad": 0.4, "liftoff_rad": 0.4, "stood": true}]})");
   EXPECT_THAT(status.message(), HasSubstr("sim.json: /runs/0/liftof_rad: unknown key"));
 }
 
@@ -165,31 +170,36 @@ TEST(SimResults, UnknownTopLevelKeyIsRejected) {
 
 TEST(SimResults, StandingRunWithoutLiftoffNamesItsPointer) {
   const Status status =
-      LoadError(std::string("{") + kHeader + R"(, "runs": [{"foot": "B", "tension_point": "mean", "stood": true}]})");
+      LoadError(std::string("{") + kHeader +
+                R"(, "runs": [{"foot": "B", "tension_point": "mean", "stood": true}]})");
   EXPECT_THAT(status.message(), HasSubstr("sim.json: /runs/0/liftoff_rad: missing required field"));
 }
 
 TEST(SimResults, MissingStoodNamesItsPointer) {
   const Status status =
-      LoadError(std::string("{") + kHeader + R"(, "runs": [{"foot": "B", "tension_point": "mean", "liftoff_rad": 0.4}]})");
+      LoadError(std::string("{") + kHeader +
+                R"(, "runs": [{"foot": "B", "tension_point": "mean", "liftoff_rad": 0.4}]})");
   EXPECT_THAT(status.message(), HasSubstr("sim.json: /runs/0/stood: missing required field"));
 }
 
 TEST(SimResults, BadSummaryFootNamesItsPointer) {
-  const Status status =
-      LoadError(std::string("{") + kHeader + R"(, "summary": {"E": {"min_rad": 0.1, "max_rad": 0.2}}})");
-  EXPECT_THAT(status.message(), HasSubstr("sim.json: /summary/E: unknown foot; expected one of A, B, C, D"));
+  const Status status = LoadError(std::string("{") + kHeader +
+                                  R"(, "summary": {"E": {"min_rad": 0.1, "max_rad": 0.2}}})");
+  EXPECT_THAT(status.message(),
+              HasSubstr("sim.json: /summary/E: unknown foot; expected one of A, B, C, D"));
 }
 
 TEST(SimResults, SummaryMaxBelowMinNamesItsPointer) {
-  const Status status =
-      LoadError(std::string("{") + kHeader + R"(, "summary": {"A": {"min_rad": 0.5, "max_rad": 0.2}}})");
-  EXPECT_THAT(status.message(), HasSubstr("sim.json: /summary/A/max_rad: expected a number >= min_rad (0.5), got 0.2"));
+  const Status status = LoadError(std::string("{") + kHeader +
+                                  R"(, "summary": {"A": {"min_rad": 0.5, "max_rad": 0.2}}})");
+  EXPECT_THAT(
+      status.message(),
+      HasSubstr("sim.json: /summary/A/max_rad: expected a number >= min_rad (0.5), got 0.2"));
 }
 
 TEST(SimResults, NegativeSummaryValueNamesItsPointer) {
-  const Status status =
-      LoadError(std::string("{") + kHeader + R"(, "summary": {"D": {"min_rad": -0.25, "max_rad": 0.43}}})");
+  const Status status = LoadError(std::string("{") + kHeader +
+                                  R"(, "summary": {"D": {"min_rad": -0.25, "max_rad": 0.43}}})");
   EXPECT_THAT(status.message(), HasSubstr("sim.json: /summary/D/min_rad: expected a number >= 0"));
 }
 
@@ -199,12 +209,15 @@ TEST(SimResults, NeitherRunsNorSummaryIsAnError) {
 }
 
 TEST(SimResults, WrongFormatNamesItsPointer) {
-  const Status status = LoadError(R"({"format": "liftoff-log", "version": 1, "model": "m", "runs": []})");
-  EXPECT_THAT(status.message(), HasSubstr("sim.json: /format: expected one of liftoff-sim-results"));
+  const Status status =
+      LoadError(R"({"format": "liftoff-log", "version": 1, "model": "m", "runs": []})");
+  EXPECT_THAT(status.message(),
+              HasSubstr("sim.json: /format: expected one of liftoff-sim-results"));
 }
 
 TEST(SimResults, NewerVersionIsUnsupported) {
-  const Status status = LoadError(R"({"format": "liftoff-sim-results", "version": 2, "model": "m", "runs": []})");
+  const Status status =
+      LoadError(R"({"format": "liftoff-sim-results", "version": 2, "model": "m", "runs": []})");
   EXPECT_EQ(status.code(), StatusCode::kUnsupported);
   EXPECT_THAT(status.message(), HasSubstr("sim.json: /version: version 2"));
 }
@@ -356,36 +369,43 @@ TEST(ResultsTable, NotesReportFallenRunsSummariesAndTrialsWithoutValue) {
 TEST(ResultsTable, MarkdownHasHeaderRowValuesAndCalibrationLine) {
   const auto trials = Trials2018AD();
   const SimResults sim = PublishedSimABC();
-  const std::string md =
-      RenderResultsTable(BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kMarkdown);
-  EXPECT_TRUE(HasLine(md, "| Foot | Sim min | Sim max | HW min | HW max | HW n | HW mean | HW sd | "
-                          "HW median | HW 95 % CI of mean |"))
+  const std::string md = RenderResultsTable(
+      BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kMarkdown);
+  EXPECT_TRUE(HasLine(md,
+                      "| Foot | Sim min | Sim max | HW min | HW max | HW n | HW mean | HW sd | "
+                      "HW median | HW 95 % CI of mean |"))
       << md;
-  EXPECT_TRUE(HasLine(md, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | :---: |")) << md;
+  EXPECT_TRUE(
+      HasLine(md, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | :---: |"))
+      << md;
   // A: mean 0.4468, sd 0.0428, CI 0.3937 .. 0.4999 (statistics_test), 3 decimals
-  EXPECT_TRUE(HasLine(md, "| A | 0.330 | 0.470 | 0.385 | 0.502 | 5 | 0.447 | 0.043 | 0.455 | [0.394, 0.500] |"))
+  EXPECT_TRUE(HasLine(
+      md, "| A | 0.330 | 0.470 | 0.385 | 0.502 | 5 | 0.447 | 0.043 | 0.455 | [0.394, 0.500] |"))
       << md;
   EXPECT_TRUE(HasLine(md, "| B | 0.350 | 0.470 | – | – | 0 | – | – | – | – |")) << md;
   EXPECT_THAT(md, HasSubstr("| D | – | – | 0.357 | 0.438 | 5 | 0.412 |"));
-  EXPECT_TRUE(HasLine(md, std::string("Calibration: ") + kCalibration + ". Lookup: " + kLookupRule + "."))
+  EXPECT_TRUE(
+      HasLine(md, std::string("Calibration: ") + kCalibration + ". Lookup: " + kLookupRule + "."))
       << md;
 }
 
 TEST(ResultsTable, CsvParsesBackWithHeaderAndBlankSimCells) {
   const auto trials = Trials2018AD();
   const SimResults sim = PublishedSimABC();
-  const std::string csv =
-      RenderResultsTable(BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kCsv);
+  const std::string csv = RenderResultsTable(
+      BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kCsv);
   const auto records = ParseCsv(csv);
   ASSERT_EQ(records.size(), 5u);
-  const std::vector<std::string> header = {"foot", "sim_min_rad", "sim_max_rad", "sim_n_runs",
-                                           "hw_min_rad", "hw_max_rad", "hw_n", "hw_mean_rad",
-                                           "hw_sd_rad", "hw_median_rad", "hw_ci95_low_rad",
-                                           "hw_ci95_high_rad", "calibration", "lookup_rule"};
+  const std::vector<std::string> header = {"foot",          "sim_min_rad",     "sim_max_rad",
+                                           "sim_n_runs",    "hw_min_rad",      "hw_max_rad",
+                                           "hw_n",          "hw_mean_rad",     "hw_sd_rad",
+                                           "hw_median_rad", "hw_ci95_low_rad", "hw_ci95_high_rad",
+                                           "calibration",   "lookup_rule"};
   EXPECT_EQ(records[0], header);
   for (const auto& record : records) ASSERT_EQ(record.size(), header.size());
-  const std::vector<std::string> a = {"A", "0.330", "0.470", "0", "0.385", "0.502", "5", "0.447",
-                                      "0.043", "0.455", "0.394", "0.500", kCalibration, kLookupRule};
+  const std::vector<std::string> a = {"A",     "0.330", "0.470",      "0",        "0.385",
+                                      "0.502", "5",     "0.447",      "0.043",    "0.455",
+                                      "0.394", "0.500", kCalibration, kLookupRule};
   EXPECT_EQ(records[1], a);
   // B has no hardware values, D no simulation: empty fields
   EXPECT_EQ(records[2][4], "");
@@ -400,8 +420,8 @@ TEST(ResultsTable, CsvParsesBackWithHeaderAndBlankSimCells) {
 
 TEST(ResultsTable, CsvWithoutSimLeavesSimColumnsBlank) {
   const auto trials = Trials2018AD();
-  const auto records =
-      ParseCsv(RenderResultsTable(BuildResultsTable(trials, nullptr, kCalibration, kLookupRule), TableFormat::kCsv));
+  const auto records = ParseCsv(RenderResultsTable(
+      BuildResultsTable(trials, nullptr, kCalibration, kLookupRule), TableFormat::kCsv));
   ASSERT_EQ(records.size(), 3u);
   for (size_t row = 1; row < records.size(); ++row) {
     EXPECT_EQ(records[row][1], "");
@@ -412,16 +432,17 @@ TEST(ResultsTable, CsvWithoutSimLeavesSimColumnsBlank) {
 
 TEST(ResultsTable, MarkdownWithoutSimShowsDashes) {
   const auto trials = Trials2018AD();
-  const std::string md =
-      RenderResultsTable(BuildResultsTable(trials, nullptr, kCalibration, kLookupRule), TableFormat::kMarkdown);
+  const std::string md = RenderResultsTable(
+      BuildResultsTable(trials, nullptr, kCalibration, kLookupRule), TableFormat::kMarkdown);
   EXPECT_THAT(md, HasSubstr("| A | – | – | 0.385 | 0.502 |"));
 }
 
 TEST(ResultsTable, LatexUsesBooktabsAndCaptionNamesCalibration) {
   const auto trials = Trials2018AD();
   const SimResults sim = PublishedSimABC();
-  const std::string tex = RenderResultsTable(
-      BuildResultsTable(trials, &sim, "laika_2018 #2", "hold & 100% of {step}"), TableFormat::kLatex);
+  const std::string tex =
+      RenderResultsTable(BuildResultsTable(trials, &sim, "laika_2018 #2", "hold & 100% of {step}"),
+                         TableFormat::kLatex);
   EXPECT_THAT(tex, HasSubstr("\\toprule"));
   EXPECT_THAT(tex, HasSubstr("\\midrule"));
   EXPECT_THAT(tex, HasSubstr("\\bottomrule"));
@@ -433,15 +454,18 @@ TEST(ResultsTable, LatexUsesBooktabsAndCaptionNamesCalibration) {
   const std::string caption_line = tex.substr(caption, tex.find('\n', caption) - caption);
   EXPECT_THAT(caption_line, HasSubstr("laika\\_2018 \\#2"));
   EXPECT_THAT(caption_line, HasSubstr("hold \\& 100\\% of \\{step\\}"));
-  EXPECT_THAT(tex, HasSubstr("A & 0.330 & 0.470 & 0.385 & 0.502 & 5 & 0.447 & 0.043 & 0.455 & [0.394, 0.500] \\\\"));
+  EXPECT_THAT(
+      tex,
+      HasSubstr(
+          "A & 0.330 & 0.470 & 0.385 & 0.502 & 5 & 0.447 & 0.043 & 0.455 & [0.394, 0.500] \\\\"));
   EXPECT_THAT(tex, HasSubstr("D & -- & -- & 0.357 & 0.438 & 5 & 0.412"));
 }
 
 TEST(ResultsTable, JsonHoldsValuesTrialsAndCalibration) {
   const auto trials = Trials2018AD();
   const SimResults sim = PublishedSimABC();
-  const std::string text =
-      RenderResultsTable(BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kJson);
+  const std::string text = RenderResultsTable(
+      BuildResultsTable(trials, &sim, kCalibration, kLookupRule), TableFormat::kJson);
   const json document = json::parse(text);
   EXPECT_EQ(document["calibration"], kCalibration);
   EXPECT_EQ(document["lookup_rule"], kLookupRule);
@@ -468,7 +492,8 @@ TEST(TrialTable, MarkdownListsEveryTrialWithInterval) {
   auto trials = Trials2018AD();
   trials[2].liftoff_rad = kNaN;
   trials[2].lower_rad = kNaN;
-  const std::string md = RenderTrialTable(trials, TableFormat::kMarkdown, kCalibration, kLookupRule);
+  const std::string md =
+      RenderTrialTable(trials, TableFormat::kMarkdown, kCalibration, kLookupRule);
   EXPECT_TRUE(HasLine(md, "| Trial | Foot | Liftoff | Interval | Flags |")) << md;
   EXPECT_TRUE(HasLine(md, "| A2 | A | 0.385 | [0.375, 0.395] | gap 0.93 s |")) << md;
   EXPECT_TRUE(HasLine(md, "| A3 | A | – | – |  |")) << md;
@@ -481,13 +506,14 @@ TEST(TrialTable, CsvParsesBackIncludingQuotedFlags) {
   auto trials = Trials2018AD();
   trials[0].flags = "gap 0.93 s, \"burst\"";
   trials[2].liftoff_rad = kNaN;
-  const auto records = ParseCsv(RenderTrialTable(trials, TableFormat::kCsv, kCalibration, kLookupRule));
+  const auto records =
+      ParseCsv(RenderTrialTable(trials, TableFormat::kCsv, kCalibration, kLookupRule));
   ASSERT_EQ(records.size(), 11u);
-  const std::vector<std::string> header = {"trial_id", "foot",  "liftoff_rad", "lower_rad",
+  const std::vector<std::string> header = {"trial_id",  "foot",  "liftoff_rad", "lower_rad",
                                            "upper_rad", "flags", "calibration", "lookup_rule"};
   EXPECT_EQ(records[0], header);
-  const std::vector<std::string> first = {"A1",    "A",   "0.460", "0.450", "0.470", "gap 0.93 s, \"burst\"",
-                                          kCalibration, kLookupRule};
+  const std::vector<std::string> first = {
+      "A1", "A", "0.460", "0.450", "0.470", "gap 0.93 s, \"burst\"", kCalibration, kLookupRule};
   EXPECT_EQ(records[1], first);
   EXPECT_EQ(records[3][2], "");
   EXPECT_EQ(records[10][0], "D5");
@@ -510,7 +536,8 @@ TEST(TrialTable, JsonHoldsFullPrecisionAndNulls) {
   auto trials = Trials2018AD();
   trials[2].liftoff_rad = kNaN;
   trials[0].liftoff_rad = 0.4601234567891;
-  const json document = json::parse(RenderTrialTable(trials, TableFormat::kJson, kCalibration, kLookupRule));
+  const json document =
+      json::parse(RenderTrialTable(trials, TableFormat::kJson, kCalibration, kLookupRule));
   EXPECT_EQ(document["calibration"], kCalibration);
   EXPECT_EQ(document["lookup_rule"], kLookupRule);
   ASSERT_EQ(document["trials"].size(), 10u);
@@ -529,7 +556,8 @@ TEST(TableFormat, ParsesEveryNameAndRejectsOthers) {
   EXPECT_EQ(ParseTableFormat("html"), std::nullopt);
   EXPECT_EQ(ParseTableFormat("CSV"), std::nullopt);
   EXPECT_EQ(ParseTableFormat(""), std::nullopt);
-  for (TableFormat format : {TableFormat::kMarkdown, TableFormat::kCsv, TableFormat::kLatex, TableFormat::kJson}) {
+  for (TableFormat format :
+       {TableFormat::kMarkdown, TableFormat::kCsv, TableFormat::kLatex, TableFormat::kJson}) {
     EXPECT_EQ(ParseTableFormat(TableFormatName(format)), format);
   }
 }

@@ -27,8 +27,8 @@ ScratchDir::ScratchDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "test";
   std::random_device random;
-  path_ = std::filesystem::temp_directory_path() /
-          ("liftoff-" + name + "-" + std::to_string(random()));
+  path_ =
+      std::filesystem::temp_directory_path() / ("liftoff-" + name + "-" + std::to_string(random()));
   std::filesystem::create_directories(path_);
 }
 

@@ -47,9 +47,9 @@ std::string ReadFile(const std::filesystem::path& path);
 
 /// Skips the current test with a message when the reference data is absent (a user's
 /// fresh clone has no ../shared).
-#define LIFTOFF_REQUIRE_REFERENCE(dir_var)                                                \
-  const auto dir_var##_opt = ::liftoff::testing::ReferenceDir();                          \
-  if (!dir_var##_opt) {                                                                   \
+#define LIFTOFF_REQUIRE_REFERENCE(dir_var)                                              \
+  const auto dir_var##_opt = ::liftoff::testing::ReferenceDir();                        \
+  if (!dir_var##_opt) {                                                                 \
     GTEST_SKIP() << "../shared/reference is absent (a fresh clone has none); skipping"; \
-  }                                                                                       \
+  }                                                                                     \
   const std::filesystem::path dir_var = *dir_var##_opt

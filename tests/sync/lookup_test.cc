@@ -270,8 +270,8 @@ TEST(LookupVertebraAngle, EmptyLogOrNoAngleIsNotFound) {
   auto empty = LookupVertebraAngle(ControllerLog{}, 0, 0, LookupOptions{});
   EXPECT_EQ(empty.status().code(), StatusCode::kNotFound);
   EXPECT_THAT(empty.status().message(), HasSubstr("no samples"));
-  auto no_angle = LookupVertebraAngle(MakeLog({{0, kNotMeasured}, {100, kNotMeasured}}), 0, 0,
-                                      LookupOptions{});
+  auto no_angle =
+      LookupVertebraAngle(MakeLog({{0, kNotMeasured}, {100, kNotMeasured}}), 0, 0, LookupOptions{});
   EXPECT_EQ(no_angle.status().code(), StatusCode::kNotFound);
   EXPECT_THAT(no_angle.status().message(), HasSubstr("vertebra angle"));
 }

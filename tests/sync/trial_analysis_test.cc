@@ -14,11 +14,10 @@
 namespace liftoff::sync {
 namespace {
 
-using ::testing::HasSubstr;
-using ::testing::StartsWith;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::WriteFile;
-
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
 
 EventTimes HandTimes(int64_t led_on_ms, int64_t liftoff_ms) {
   EventTimes times;
@@ -62,7 +61,8 @@ TEST(AnalyzeManifest, AMissingLogFailsOnlyItsTrialAndNamesTheFile) {
   manifest.trials.push_back(Trial("B2", Foot::kB, scratch / "missing.txt"));
   manifest.trials.back().times = HandTimes(5000, 5350);
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   ASSERT_EQ(analysis.outcomes.size(), 2u);
   EXPECT_EQ(analysis.failed, 1);
   EXPECT_EQ(analysis.rule, LookupRule::kSampleAndHold);
@@ -101,7 +101,8 @@ TEST(AnalyzeManifest, ValuesFlagGapsAndQueriesPastTheEnd) {
   manifest.trials.push_back(Trial("D3", Foot::kD, scratch / "bursts.txt"));
   manifest.trials.back().times = HandTimes(1000, 7530);  // log 6.530 s: 0.5 s past the end
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   EXPECT_EQ(analysis.failed, 0);
   const std::vector<stats::TrialValue> values = analysis.Values();
   ASSERT_EQ(values.size(), 2u);
@@ -124,7 +125,8 @@ TEST(AnalyzeManifest, TrialsWithoutTimesFailWithTheirReason) {
   manifest.trials.push_back(Trial("A3", Foot::kA, scratch / "good.txt"));
   manifest.trials.back().times = HandTimes(0, 700);
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   ASSERT_EQ(analysis.outcomes.size(), 3u);
   EXPECT_EQ(analysis.failed, 2);
   const Status& video_only = analysis.outcomes[0].status;
@@ -148,7 +150,8 @@ TEST(AnalyzeManifest, LookupErrorsNameTheTrialAndTheLog) {
   manifest.trials.push_back(Trial("C4", Foot::kC, scratch / "short.txt"));
   manifest.trials.back().times = HandTimes(0, 5000);  // 4 s past the 1 s log
 
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   EXPECT_EQ(analysis.failed, 1);
   const Status& status = analysis.outcomes[0].status;
   EXPECT_EQ(status.code(), StatusCode::kOutOfRange);
@@ -167,7 +170,8 @@ TEST(AnalyzeManifest, InvalidOptionsFailEveryTrial) {
   AnalysisOptions options;
   options.lookup.gap_threshold_s = -1.0;
   EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
-  const ManifestAnalysis analysis = AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), options);
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), options);
   EXPECT_EQ(analysis.failed, 1);
   EXPECT_THAT(analysis.outcomes[0].status.message(), StartsWith("A1: "));
   EXPECT_THAT(analysis.outcomes[0].status.message(), HasSubstr("gap_threshold_s"));
@@ -186,8 +190,8 @@ const std::map<std::string, double>& AuthorsAngles() {
 TEST(AnalyzeManifest, Laika2018SampleAndHoldReproducesTheAuthorsAngles) {
   LIFTOFF_REQUIRE_REFERENCE(reference);
   ScratchDir scratch;
-  auto imported = capture::ImportLaika2018Folder(reference / "laika-2018-hardware",
-                                                 scratch / "trials.json");
+  auto imported =
+      capture::ImportLaika2018Folder(reference / "laika-2018-hardware", scratch / "trials.json");
   ASSERT_TRUE(imported.ok()) << imported.status().ToString();
   auto calibration = LoadCalibration(liftoff::testing::SourceDir() / "calib" / "laika-2018.json");
   ASSERT_TRUE(calibration.ok()) << calibration.status().ToString();
@@ -195,8 +199,7 @@ TEST(AnalyzeManifest, Laika2018SampleAndHoldReproducesTheAuthorsAngles) {
   const ManifestAnalysis hold = AnalyzeManifest(imported->manifest, *calibration, Hold());
   AnalysisOptions linear_options;
   linear_options.lookup.rule = LookupRule::kLinear;
-  const ManifestAnalysis linear =
-      AnalyzeManifest(imported->manifest, *calibration, linear_options);
+  const ManifestAnalysis linear = AnalyzeManifest(imported->manifest, *calibration, linear_options);
   EXPECT_EQ(hold.failed, 0);
   EXPECT_EQ(linear.failed, 0);
   ASSERT_EQ(hold.outcomes.size(), 20u);
@@ -213,8 +216,8 @@ TEST(AnalyzeManifest, Laika2018SampleAndHoldReproducesTheAuthorsAngles) {
     EXPECT_LE(measurement.lower_rad, measurement.liftoff_rad);
     EXPECT_GE(measurement.upper_rad, measurement.liftoff_rad);
     // B1's liftoff (9.170 s) is past its log's last sample (9.079 s): held and flagged
-    EXPECT_EQ(measurement.lookup.past_end, outcome.trial.id == "B1" || outcome.trial.id == "A4" ||
-                                               outcome.trial.id == "C1");
+    EXPECT_EQ(measurement.lookup.past_end,
+              outcome.trial.id == "B1" || outcome.trial.id == "A4" || outcome.trial.id == "C1");
     if (outcome.trial.id == "B1") {
       EXPECT_EQ(measurement.liftoff_log_ns, NsFromMilliseconds(9170));
       EXPECT_EQ(measurement.lookup.sample_before_ns, NsFromMilliseconds(9079));

@@ -95,8 +95,7 @@ struct AngleLookup {
 /// more than options.max_past_end_s outside the log ("instant 12.400 s is after the log's
 /// last sample at 9.079 s (log spans 0.004-9.079 s)").
 Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_ns,
-                                        int64_t query_uncertainty_ns,
-                                        const LookupOptions& options);
+                                        int64_t query_uncertainty_ns, const LookupOptions& options);
 
 /// One trial's liftoff angle.
 struct LiftoffMeasurement {
