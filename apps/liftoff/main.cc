@@ -43,7 +43,10 @@ int main(int argc, char** argv) {
   TableCommand table;
   CLI::App* table_app = app.add_subcommand(
       "table", "Rotation at liftoff per trial and the per-foot table (paper Table IV layout)");
-  table_app->add_option("manifest", table.manifest_path, "Trial manifest (JSON)")->required();
+  table_app
+      ->add_option("manifest", table.manifest_path,
+                   "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
+      ->required();
   AddCalibrationFlag(table_app, table.calibration);
   AddLookupFlags(table_app, table.lookup);
   table_app->add_option("--format,-f", table.format, "md, csv, latex or json")

@@ -39,6 +39,20 @@ int Emit(const std::string& text, const std::filesystem::path& output_path, std:
   return kExitOk;
 }
 
+// A manifest file, or a 2018 Laika folder imported on the fly (warnings to `err`).
+Result<TrialManifest> LoadTrials(const std::filesystem::path& path, std::ostream& err) {
+  if (!std::filesystem::is_directory(path)) return LoadManifest(path);
+  if (!std::filesystem::exists(path / capture::kLaika2018TimesCsv)) {
+    return InvalidArgumentError(path.string() + ": is a folder without \"" +
+                                capture::kLaika2018TimesCsv +
+                                "\"; expected a trial manifest (JSON) or a 2018 Laika folder");
+  }
+  auto imported = capture::ImportLaika2018Folder(path, path / "manifest.json");
+  if (!imported.ok()) return imported.status();
+  for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
+  return std::move(imported->manifest);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -60,8 +74,8 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   auto lookup = LookupOptionsFrom(command.lookup);
   if (!lookup.ok()) return ReportError(lookup.status(), err);
 
-  // inputs: manifest, calibration, optional simulation results
-  auto manifest = LoadManifest(command.manifest_path);
+  // inputs: manifest (or a 2018 folder read as one), calibration, optional sim results
+  auto manifest = LoadTrials(command.manifest_path, err);
   if (!manifest.ok()) return ReportError(manifest.status(), err);
   auto calibration = ChooseCalibration(
       command.calibration, manifest->calibration_path.value_or(std::filesystem::path()));

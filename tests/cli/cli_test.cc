@@ -222,6 +222,41 @@ TEST(CliTable, OneBadTrialDoesNotLoseTheOthers) {
   EXPECT_THAT(run.out, HasSubstr("0.500"));  // shaft 2 rad at log time 2 s, over the 4:1 spur gear
 }
 
+TEST(CliTable, SimulationResultsFillTheSimColumns) {
+  ScratchDir scratch;
+  const nlohmann::json sim = {{"format", "liftoff-sim-results"},
+                              {"version", 1},
+                              {"model", "test"},
+                              {"summary", {{"A", {{"min_rad", 0.123}, {"max_rad", 0.456}}}}}};
+  WriteFile(scratch / "sim.json", sim.dump());
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, RampLog2018(5000), 1.0, 3.0);
+  command.sim_path = scratch / "sim.json";
+  command.format = "csv";
+  command.tables = "feet";
+  const CommandRun run = RunTableCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("0.123"));
+  EXPECT_THAT(run.out, HasSubstr("0.456"));
+  EXPECT_THAT(run.out, HasSubstr("0.500"));  // the hardware value beside them
+
+  // a bad simulation file is named with its JSON path
+  WriteFile(scratch / "sim.json", R"({"format": "liftoff-sim-results", "version": 1, "model": "m",
+      "summary": {"E": {"min_rad": 0.1, "max_rad": 0.2}}})");
+  const CommandRun bad = RunTableCommand(command);
+  EXPECT_EQ(bad.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(bad.err, HasSubstr("sim.json: /summary"));
+}
+
+TEST(CliTable, AFolderThatIsNotA2018FolderIsRejected) {
+  ScratchDir scratch;
+  TableCommand command;
+  command.manifest_path = scratch.path();
+  const CommandRun run = RunTableCommand(command);
+  EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(run.err, HasSubstr("foot lifting times from hw videos.csv"));
+}
+
 TEST(CliTable, BadFlagValuesAreRejected) {
   TableCommand command;
   command.manifest_path = SourceDir() / "samples" / "trials" / "manifest.json";
@@ -315,6 +350,11 @@ TEST(CliImport2018, ReferenceDataGivesThePublishedSampleAndHoldValues) {
 
   const CommandRun table =
       RunBinary("table " + Quoted(manifest) + " --rule hold --format json", scratch);
+  // the folder itself, imported on the fly, gives the very same table
+  const CommandRun direct = RunBinary(
+      "table " + Quoted(reference / "laika-2018-hardware") + " --rule hold --format json", scratch);
+  EXPECT_EQ(direct.code, 0) << direct.err;
+  EXPECT_EQ(direct.out, table.out);
   ASSERT_EQ(table.code, 0) << table.err;
   const nlohmann::json document = nlohmann::json::parse(table.out);
   // laika-model.md section 7: the authors' rule on the 20 tests

@@ -45,6 +45,8 @@ struct LookupChoice {
 
 /// `liftoff table MANIFEST`: per-trial angles at liftoff and the per-foot table.
 struct TableCommand {
+  /// Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV), imported as
+  /// `liftoff import-2018` would.
   std::filesystem::path manifest_path;
   CalibrationChoice calibration;
   LookupChoice lookup;
