@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
 
 namespace {
@@ -31,6 +32,18 @@ void AddLookupFlags(CLI::App* app, LookupChoice& lookup) {
   app->add_option("--max-bad-lines", lookup.max_bad_lines,
                   "Malformed log lines to skip (reported) before a log is rejected")
       ->capture_default_str();
+}
+
+void AddTestFlags(CLI::App* app, TestChoice& test) {
+  app->add_option("--pulled", test.pulled_group, "Cable group the bend pulls: HR or HL")
+      ->capture_default_str();
+  app->add_option("--bend-percent", test.bend_percent,
+                  "Bend each cable of the group to this percentage of its rest length")
+      ->capture_default_str();
+  app->add_option("--ramp-deg", test.ramp_deg,
+                  "Rotating vertebra's ramp amplitude, degrees, signed by direction")
+      ->capture_default_str();
+  app->add_option("--ramp-s", test.ramp_s, "Ramp duration, seconds")->capture_default_str();
 }
 
 }  // namespace
@@ -98,6 +111,74 @@ int main(int argc, char** argv) {
                         "Calibration JSON (default: calib/laika-2018.json)");
   calib_app->add_flag("--json", calib.json, "Print the calibration as JSON");
 
+  CaptureCommand capture;
+  CLI::App* capture_app = app.add_subcommand(
+      "capture", "Record a test from the controller's serial port: raw journal + controller log");
+  capture_app->add_option("port", capture.port, "Serial port: device path, stable id or symlink")
+      ->required();
+  capture_app->add_option("--output,-o", capture.log_path, "Controller log to write")->required();
+  capture_app->add_option("--journal", capture.journal_path, "Raw journal (default: LOG.journal)");
+  capture_app->add_option("--baud", capture.baud_rate, "Line speed, bits/s")->capture_default_str();
+  capture_app->add_flag("--start", capture.send_start,
+                        "Send START with the test parameters and record them in the log");
+  AddTestFlags(capture_app, capture.test);
+  capture_app->add_option("--max-duration", capture.max_duration_s, "Stop after this long, s")
+      ->capture_default_str();
+  capture_app
+      ->add_option("--first-frame-timeout", capture.first_frame_timeout_s,
+                   "Fail when no frame arrives this long after opening, s (0: wait for ever)")
+      ->capture_default_str();
+  capture_app->add_flag("--no-stop-on-test-end", capture.no_stop_on_test_end,
+                        "Keep capturing after the controller's TEST_END");
+  capture_app
+      ->add_option("--reconnect-poll", capture.reconnect_poll_s,
+                   "Look for an unplugged port this often, s")
+      ->capture_default_str();
+  capture_app->add_option("--status", capture.status, "Status line: auto, live, lines or off")
+      ->capture_default_str();
+  AddCalibrationFlag(capture_app, capture.calibration);
+
+  EmulateCommand emulate;
+  CLI::App* emulate_app = app.add_subcommand(
+      "emulate", "A test controller on a pseudo-terminal (prints its path), with fault injection");
+  emulate_app->add_option("--rate", emulate.rate_hz, "Sample frames per second")
+      ->capture_default_str();
+  emulate_app->add_flag("--unpaced", emulate.unpaced, "Send as fast as the reader takes frames");
+  emulate_app->add_flag("--autostart", emulate.autostart, "Start the test without a START command");
+  AddTestFlags(emulate_app, emulate.test);
+  emulate_app->add_option("--link", emulate.link_path,
+                          "Stable symlink to the pseudo-terminal (kept across disconnects)");
+  emulate_app->add_option("--corrupt", emulate.corrupt_probability,
+                          "Probability that a byte gets a bit flipped");
+  emulate_app->add_option("--drop", emulate.drop_probability,
+                          "Probability that a frame is dropped");
+  emulate_app->add_option("--stall-at", emulate.stall_at_s, "Pause the output at this time, s");
+  emulate_app->add_option("--stall-for", emulate.stall_for_s, "... for this long, s");
+  emulate_app->add_option("--disconnect-at", emulate.disconnect_at_s,
+                          "Unplug at this time, s (needs --link)");
+  emulate_app->add_option("--disconnect-for", emulate.disconnect_for_s, "... for this long, s");
+  emulate_app->add_option("--drift-ppm", emulate.drift_ppm, "Device clock rate error, ppm");
+  emulate_app->add_option("--seed", emulate.seed, "Seed of the fault generator")
+      ->capture_default_str();
+  emulate_app->add_option("--duration", emulate.duration_s, "Run this long, s (0: until done)");
+  emulate_app->add_flag("--keep-running", emulate.keep_running,
+                        "Keep running after the test ends (until Ctrl-C or --duration)");
+
+  PortsCommand ports;
+  CLI::App* ports_app = app.add_subcommand("ports", "List the serial ports of this machine");
+
+  JournalCommand journal;
+  CLI::App* journal_app =
+      app.add_subcommand("journal", "Show a capture journal, or rebuild its controller log");
+  journal_app->add_option("journal", journal.journal_path, "Capture journal")->required();
+  journal_app->add_flag("--replay", journal.replay,
+                        "Rebuild the controller log with live capture's parsing");
+  journal_app->add_option("--output,-o", journal.output_path, "With --replay: log to write");
+  journal_app->add_flag("--force", journal.force, "Overwrite an existing output file");
+  journal_app->add_flag("--hex", journal.hex, "Dump bytes as hexadecimal");
+  journal_app->add_option("--max-records", journal.max_records, "Dump at most this many records");
+  AddCalibrationFlag(journal_app, journal.calibration);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -111,6 +192,10 @@ int main(int argc, char** argv) {
     if (*sync_app) return RunSync(sync, std::cout, std::cerr);
     if (*log_app) return RunLog(log, std::cout, std::cerr);
     if (*calib_app) return RunCalib(calib, std::cout, std::cerr);
+    if (*capture_app) return RunCapture(capture, std::cout, std::cerr);
+    if (*emulate_app) return RunEmulate(emulate, std::cout, std::cerr);
+    if (*ports_app) return RunPorts(ports, std::cout, std::cerr);
+    if (*journal_app) return RunJournal(journal, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "liftoff: internal error: " << error.what() << '\n';
     return kExitInternal;
