@@ -34,14 +34,14 @@ enum class FrameType : char {
 
 /// Controller events (the `kind` field of an E frame, on the wire as its name).
 enum class EventKind : uint8_t {
-  kLedOn = 0,     ///< LED_ON: the sync LED switched on
-  kLedOff,        ///< LED_OFF
-  kTestStart,     ///< TEST_START: the test sequence began (arg: 0)
-  kTestEnd,       ///< TEST_END: the test sequence finished (arg: 0 done, 1 stopped)
-  kFault,         ///< FAULT: arg is a fault code, text names it
-  kPong,          ///< PONG: reply to PING, arg echoes its token
-  kAck,           ///< ACK: a command was accepted, arg is its command code
-  kNak,           ///< NAK: a command was refused, arg is its command code, text says why
+  kLedOn = 0,  ///< LED_ON: the sync LED switched on
+  kLedOff,     ///< LED_OFF
+  kTestStart,  ///< TEST_START: the test sequence began (arg: 0)
+  kTestEnd,    ///< TEST_END: the test sequence finished (arg: 0 done, 1 stopped)
+  kFault,      ///< FAULT: arg is a fault code, text names it
+  kPong,       ///< PONG: reply to PING, arg echoes its token
+  kAck,        ///< ACK: a command was accepted, arg is its command code
+  kNak,        ///< NAK: a command was refused, arg is its command code, text says why
   kCount
 };
 
@@ -56,11 +56,11 @@ enum class CommandKind : uint8_t {
 
 /// A sample frame: $S,seq,t_us,led,bend_counts,rotate_counts,bend_setpoint,rotate_setpoint
 struct SampleFrame {
-  uint32_t sequence = 0;            ///< frame counter shared by S, H and E frames; wraps
-  uint32_t device_time_us = 0;      ///< controller clock, microseconds; wraps at 2^32
-  uint8_t led_on = 0;               ///< 0 or 1
-  int32_t bend_counts = 0;          ///< bending motor encoder, counts
-  int32_t rotate_counts = 0;        ///< rotating motor encoder, counts
+  uint32_t sequence = 0;               ///< frame counter shared by S, H and E frames; wraps
+  uint32_t device_time_us = 0;         ///< controller clock, microseconds; wraps at 2^32
+  uint8_t led_on = 0;                  ///< 0 or 1
+  int32_t bend_counts = 0;             ///< bending motor encoder, counts
+  int32_t rotate_counts = 0;           ///< rotating motor encoder, counts
   int32_t bend_setpoint_counts = 0;    ///< commanded bending position, counts
   int32_t rotate_setpoint_counts = 0;  ///< commanded rotation position, counts
 };
@@ -392,20 +392,20 @@ inline DecodeError DecodeLine(const char* line, size_t size, Frame* frame) {
       frame->type = FrameType::kSample;
       SampleFrame& s = frame->sample;
       uint32_t led = 0;
-      ok = ok && r.Unsigned(s.sequence) && r.Comma() && r.Unsigned(s.device_time_us) &&
-           r.Comma() && r.Unsigned(led) && led <= 1 && r.Comma() && r.Signed(s.bend_counts) &&
-           r.Comma() && r.Signed(s.rotate_counts) && r.Comma() &&
-           r.Signed(s.bend_setpoint_counts) && r.Comma() && r.Signed(s.rotate_setpoint_counts);
+      ok = ok && r.Unsigned(s.sequence) && r.Comma() && r.Unsigned(s.device_time_us) && r.Comma() &&
+           r.Unsigned(led) && led <= 1 && r.Comma() && r.Signed(s.bend_counts) && r.Comma() &&
+           r.Signed(s.rotate_counts) && r.Comma() && r.Signed(s.bend_setpoint_counts) &&
+           r.Comma() && r.Signed(s.rotate_setpoint_counts);
       s.led_on = static_cast<uint8_t>(led);
       break;
     }
     case 'H': {
       frame->type = FrameType::kHeader;
       HeaderFrame& h = frame->header;
-      ok = ok && r.Unsigned(h.sequence) && r.Comma() && r.Unsigned(h.device_time_us) &&
-           r.Comma() && r.Unsigned(h.protocol_version) && r.Comma() && r.Text(h.firmware) &&
-           r.Comma() && r.Unsigned(h.counts_per_motor_rev) && r.Comma() &&
-           r.Unsigned(h.gearbox_ratio) && r.Comma() && r.Unsigned(h.spur_gear_ratio);
+      ok = ok && r.Unsigned(h.sequence) && r.Comma() && r.Unsigned(h.device_time_us) && r.Comma() &&
+           r.Unsigned(h.protocol_version) && r.Comma() && r.Text(h.firmware) && r.Comma() &&
+           r.Unsigned(h.counts_per_motor_rev) && r.Comma() && r.Unsigned(h.gearbox_ratio) &&
+           r.Comma() && r.Unsigned(h.spur_gear_ratio);
       break;
     }
     case 'E': {
@@ -436,8 +436,7 @@ inline DecodeError DecodeLine(const char* line, size_t size, Frame* frame) {
       for (int i = 0; ok && i < 4; ++i) ok = r.Comma() && r.Signed(c.args[i]);
       break;
     }
-    default:
-      return DecodeError::kUnknownType;
+    default: return DecodeError::kUnknownType;
   }
   return ok && r.AtEnd() ? DecodeError::kOk : DecodeError::kBadField;
 }
