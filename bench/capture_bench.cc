@@ -27,19 +27,12 @@
 #include "liftoff/core/calibration.h"
 #include "liftoff/core/time.h"
 
+#include "bench_support.h"
+
 namespace {
 
 using namespace liftoff;
 using namespace liftoff::capture;
-
-Calibration BenchCalibration() {
-  auto calibration = LoadCalibration(DefaultCalibrationPath());
-  if (!calibration.ok()) {
-    std::fprintf(stderr, "%s\n", calibration.status().ToString().c_str());
-    std::exit(1);
-  }
-  return *calibration;
-}
 
 std::filesystem::path TempDir() {
   const auto dir = std::filesystem::temp_directory_path() /
@@ -107,7 +100,7 @@ CaptureOptions BenchCaptureOptions(const std::string& port, const std::filesyste
 void BM_CaptureThroughPty(benchmark::State& state) {
   const int64_t frames = state.range(0);
   const std::string bytes = EncodedTest(frames);
-  const Calibration calibration = BenchCalibration();
+  const Calibration calibration = bench::ShippedCalibration();
   const auto dir = TempDir();
   for (auto _ : state) {
     auto pty = PseudoTerminal::Open();
@@ -184,7 +177,7 @@ BENCHMARK(BM_PlainReadThroughPty)
 // of ready-made frames: both ends on this machine's two cores.
 void BM_CaptureFromUnpacedEmulator(benchmark::State& state) {
   const double duration_s = 3.0;
-  const Calibration calibration = BenchCalibration();
+  const Calibration calibration = bench::ShippedCalibration();
   const auto dir = TempDir();
   for (auto _ : state) {
     EmulatorOptions options;
@@ -240,7 +233,7 @@ BENCHMARK(BM_CaptureFromUnpacedEmulator)
 
 void BM_CaptureCpuAt1kHz(benchmark::State& state) {
   const double duration_s = 5.0;
-  const Calibration calibration = BenchCalibration();
+  const Calibration calibration = bench::ShippedCalibration();
   const auto dir = TempDir();
   for (auto _ : state) {
     EmulatorOptions options;

@@ -15,23 +15,15 @@
 #include "liftoff/core/controller_log.h"
 #include "liftoff/sync/lookup.h"
 
+#include "bench_support.h"
+
 namespace {
 
 using namespace liftoff;
 
-// The shipped calibration (calib/laika-2018.json); the benchmark stops if it is missing.
-Calibration BenchCalibration() {
-  auto calibration = LoadCalibration(DefaultCalibrationPath());
-  if (!calibration.ok()) {
-    std::fprintf(stderr, "%s\n", calibration.status().ToString().c_str());
-    std::exit(1);
-  }
-  return *calibration;
-}
-
 // A 1 kHz log of `samples` samples: counts, shaft and vertebra angles on a ramp.
 ControllerLog MakeLog(int64_t samples) {
-  const Calibration calibration = BenchCalibration();
+  const Calibration calibration = bench::ShippedCalibration();
   ControllerLog log;
   log.header.calibration = calibration.name;
   log.samples.reserve(static_cast<size_t>(samples));
@@ -81,7 +73,7 @@ void BM_ImportLaika2018Log(benchmark::State& state) {
       out << line;
     }
   }
-  const Calibration calibration = BenchCalibration();
+  const Calibration calibration = bench::ShippedCalibration();
   for (auto _ : state) {
     auto log = capture::ImportLaika2018Log(path, calibration);
     if (!log.ok()) state.SkipWithError(log.status().ToString().c_str());

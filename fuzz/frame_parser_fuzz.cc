@@ -62,21 +62,11 @@ bool SameFrame(const wire::Frame& a, const wire::Frame& b) {
   return false;
 }
 
-size_t Encode(const wire::Frame& frame, char* out, size_t capacity) {
-  switch (frame.type) {
-    case wire::FrameType::kSample: return wire::EncodeSample(frame.sample, out, capacity);
-    case wire::FrameType::kHeader: return wire::EncodeHeader(frame.header, out, capacity);
-    case wire::FrameType::kEvent: return wire::EncodeEvent(frame.event, out, capacity);
-    case wire::FrameType::kCommand: return wire::EncodeCommand(frame.command, out, capacity);
-  }
-  return 0;
-}
-
 // A decoded frame re-encodes (canonically) to a line that decodes to the same frame, and
 // that line alone through a fresh parser yields exactly that frame.
 void CheckRoundTrip(const wire::Frame& frame) {
   char text[wire::kMaxFrameBytes];
-  const size_t size = Encode(frame, text, sizeof(text));
+  const size_t size = wire::EncodeFrame(frame, text, sizeof(text));
   FUZZ_CHECK(size > 0 && size <= wire::kMaxFrameBytes);
   FUZZ_CHECK(text[0] == '$' && text[size - 1] == '\n');
   wire::Frame again;

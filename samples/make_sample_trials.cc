@@ -26,28 +26,12 @@
 #include "liftoff/core/controller_log.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
+#include "liftoff/core/random.h"
 #include "liftoff/core/time.h"
 
 namespace {
 
 using namespace liftoff;
-
-// Deterministic jitter on every platform (std::uniform_*_distribution is not portable).
-class SplitMix64 {
- public:
-  explicit SplitMix64(uint64_t seed) : state_(seed) {}
-  // Uniform in [-1, 1).
-  double Symmetric() {
-    uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
-  }
-
- private:
-  uint64_t state_;
-};
 
 struct SampleTrial {
   const char* id;

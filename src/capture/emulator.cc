@@ -1,5 +1,7 @@
 #include "liftoff/capture/emulator.h"
 
+#include "liftoff/core/random.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <time.h>
@@ -53,23 +55,6 @@ Status OutOfRange(const char* field, const char* range, double value) {
 
 // True when lo <= value <= hi (false for NaN).
 bool Within(double value, double lo, double hi) { return value >= lo && value <= hi; }
-
-// splitmix64 (Steele, Lea, Flood 2014): tiny, portable, and good enough for fault draws.
-class SplitMix64 {
- public:
-  explicit SplitMix64(uint64_t seed) : state_(seed) {}
-  uint64_t Next() {
-    uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  // uniform in [0, 1)
-  double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }
-
- private:
-  uint64_t state_;
-};
 
 uint32_t SequenceOf(const wire::Frame& frame) {
   switch (frame.type) {
@@ -239,16 +224,6 @@ const char* TestPhaseName(TestPhase phase) {
     case TestPhase::kStopped: return "stopped";
   }
   return "?";
-}
-
-size_t EncodeFrame(const wire::Frame& frame, char* out, size_t capacity) {
-  switch (frame.type) {
-    case wire::FrameType::kSample: return wire::EncodeSample(frame.sample, out, capacity);
-    case wire::FrameType::kHeader: return wire::EncodeHeader(frame.header, out, capacity);
-    case wire::FrameType::kEvent: return wire::EncodeEvent(frame.event, out, capacity);
-    case wire::FrameType::kCommand: return wire::EncodeCommand(frame.command, out, capacity);
-  }
-  return 0;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -597,7 +572,7 @@ void Emulator::Impl::Dispatch(const wire::Frame& frame) {
     return;
   }
   char bytes[wire::kMaxFrameBytes];
-  const size_t size = EncodeFrame(frame, bytes, sizeof bytes);
+  const size_t size = wire::EncodeFrame(frame, bytes, sizeof bytes);
   assert(size > 0);
   // corruption: each byte independently gets one bit flipped
   if (options.corrupt_byte_probability > 0) {

@@ -385,7 +385,7 @@ TEST(ControllerModel, SameInputsGiveTheSameBytes) {
     model.TakeFrames(frames);
     for (const wire::Frame& frame : frames) {
       char line[wire::kMaxFrameBytes];
-      const size_t size = EncodeFrame(frame, line, sizeof line);
+      const size_t size = wire::EncodeFrame(frame, line, sizeof line);
       EXPECT_GT(size, 0u);
       bytes.append(line, size);
     }

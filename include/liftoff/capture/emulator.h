@@ -135,11 +135,6 @@ enum class TestPhase {
 /// "idle", "starting", "bending", "bent", "ramping", "settling", "done", "stopped".
 const char* TestPhaseName(TestPhase phase);
 
-/// Writes `frame` (its type says which member) into `out` as one wire line; returns its
-/// length, or 0 when it does not fit `capacity` (wire::kMaxFrameBytes always does) or a
-/// text field holds a forbidden character.
-size_t EncodeFrame(const wire::Frame& frame, char* out, size_t capacity);
-
 /// The controller: deterministic and pure (no clock, no I/O, no randomness). The caller
 /// moves device time forward with Advance and Command (never backwards: an earlier time
 /// is treated as the current one), asks for samples with EmitSample, and collects the

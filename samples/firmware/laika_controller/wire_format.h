@@ -294,6 +294,17 @@ inline size_t EncodeCommand(const CommandFrame& c, char* out, size_t capacity) {
   return w.Finish();
 }
 
+/// Encodes whichever frame `frame.type` names (the other members are ignored).
+inline size_t EncodeFrame(const Frame& frame, char* out, size_t capacity) {
+  switch (frame.type) {
+    case FrameType::kSample: return EncodeSample(frame.sample, out, capacity);
+    case FrameType::kHeader: return EncodeHeader(frame.header, out, capacity);
+    case FrameType::kEvent: return EncodeEvent(frame.event, out, capacity);
+    case FrameType::kCommand: return EncodeCommand(frame.command, out, capacity);
+  }
+  return 0;
+}
+
 // ---------------------------------------------------------------------------------------
 // Decoding one line: `line` holds one frame without its '\n' (a trailing '\r' is
 // ignored). Fills `frame` and returns kOk, or says why the line is not a frame. A frame
