@@ -40,9 +40,9 @@ std::string_view VideoCodecExtension(VideoCodec codec);
 
 /// The camera and its frame timing.
 struct CameraSpec {
-  int width_px = 1280;   ///< 320 .. 1920
-  int height_px = 720;   ///< 240 .. 1080
-  double fps = 60.0;     ///< nominal frame rate: 30, 60, 120 or 240 (any in 1 .. 1000)
+  int width_px = 1280;  ///< 320 .. 1920, even (4:2:0 chroma)
+  int height_px = 720;  ///< 240 .. 1080, even
+  double fps = 60.0;    ///< nominal frame rate: 30, 60, 120 or 240 (any in 1 .. 1000)
   /// Exposure time per frame, s (0 < exposure <= 1/fps). A frame integrates the scene
   /// over [t_frame, t_frame + exposure): an LED switching on mid-exposure gives a
   /// partial-brightness frame.
@@ -99,12 +99,18 @@ struct HeightCurveSpec {
   /// "parametric": height = gain * (|theta| - liftoff_rad)^exponent above liftoff_rad;
   /// "csv": columns rotation_rad and <foot>_height_m from a simulation (liftoff sim).
   std::string kind = "parametric";
-  /// Parametric: absolute rotation at which the foot leaves the ground, rad.
+  /// Parametric: absolute rotation at which the foot leaves the ground, rad (0 .. pi).
   double liftoff_rad = 0.45;
-  /// Parametric: m per rad^exponent.
+  /// Parametric: m per rad^exponent (0 < gain <= 10).
   double gain_m = 0.25;
+  /// Parametric: 0 < exponent <= 5.
   double exponent = 1.5;
-  /// CSV: path (relative to the spec file) and the foot column to read.
+  /// CSV: path (JSON "csv", relative to the spec file; required when kind is "csv").
+  /// The file: optional '#' comment lines, a header line naming at least the columns
+  /// "rotation_rad" and "<F>_height_m" for the lifting foot F ("A_height_m"), then one
+  /// row per rotation, comma-separated, at least two rows, |rotation_rad| strictly
+  /// increasing (a simulation of either sense). Heights are interpolated linearly in
+  /// |rotation|, held at the end rows beyond them, and clamped to >= 0.
   std::filesystem::path csv_path;
 };
 
@@ -115,46 +121,49 @@ struct MotionSpec {
   /// Rotation direction (sign of the commanded angle).
   RotationSense rotation = RotationSense::kPositive;
   HeightCurveSpec height;
-  /// Test clock (s since LED on): bend phase and ramp.
+  /// Test clock (s since LED on): bend phase and ramp (0 <= bend_start_s <= bend_end_s,
+  /// all in [0, 3600]; ramp_start_s in [0, 3600]).
   double bend_start_s = 0.5;
   double bend_end_s = 3.5;
   double ramp_start_s = 4.0;
-  /// Ramp rate of the rotating vertebra, rad/s (the paper: (pi/3)/40).
+  /// Ramp rate of the rotating vertebra, rad/s (the paper: (pi/3)/40), in (0, 10].
   double ramp_rate_rad_per_s = 0.026179938779914945;
-  /// The diagonal partner of the lifting foot rises too, this much later in rotation,
-  /// rad (<= 0: it stays down).
+  /// The diagonal partner of the lifting foot (A<->D, B<->C) rises too, this much later
+  /// in rotation, rad (<= 0: it stays down), in [-pi, pi].
   double diagonal_lag_rad = 0.0;
 };
 
 /// The matching controller log.
 struct LogSpec {
   /// Device clock at the LED switch-on, ns (the 2018 firmware: 0; a modern controller
-  /// logs an led_on event at some non-zero time).
+  /// logs an led_on event at some non-zero time), 0 .. 10^15 (about 11 days).
   int64_t led_on_device_ns = 0;
-  /// Device clock rate error against the video clock, parts per million.
+  /// Device clock rate error against the video clock, parts per million (-1000 .. 1000).
   double clock_drift_ppm = 0.0;
-  /// Sample rate, Hz, and uniform timing jitter of each sample, s.
+  /// Sample rate, Hz (1 .. 10000), and uniform timing jitter of each sample, s
+  /// (0 .. 0.5 / rate_hz, so samples stay in order).
   double rate_hz = 100.0;
   double jitter_s = 0.0;
   /// Bursty like the 2018 logs: samples only in bursts of burst_length_s every
-  /// burst_period_s (0: continuous).
+  /// burst_period_s (0: continuous; otherwise 0 < burst_length_s <= burst_period_s <= 60).
   double burst_period_s = 0.0;
   double burst_length_s = 0.06;
   /// Write an explicit led_on event (otherwise the origin is the LED switch-on).
   bool led_event = true;
-  /// Seconds of log before the LED switches on and after the clip ends.
+  /// Seconds of log before the LED switches on and after the clip ends (0 .. 60 each).
   double lead_s = 0.5;
   double tail_s = 1.0;
 };
 
 /// One synthetic trial.
 struct TrialSpec {
-  /// Id used for file names and the manifest ("ci-003-h264").
+  /// Id used for file names and the manifest ("ci-003-h264"): 1 .. 100 of A-Z a-z 0-9
+  /// '.' '_' '-', not starting with '.'.
   std::string id = "synthetic";
   /// Seed of every random draw (noise, shake, drops, jitter, texture).
   uint64_t seed = 1;
   /// Clip length, s. The default holds the paper's test: LED at 1 s, ramp from 5 s,
-  /// liftoff at 0.45 rad near 22 s. Short CI clips use a faster ramp instead.
+  /// liftoff at 0.45 rad near 22 s. Short CI clips use a faster ramp instead. (0, 3600].
   double duration_s = 24.0;
   CameraSpec camera;
   NuisanceSpec nuisance;
@@ -167,7 +176,16 @@ struct TrialSpec {
 };
 
 /// Reads a trial spec from JSON (all fields optional, defaults above; unknown keys are
-/// errors naming the JSON pointer). `base_dir` resolves height.csv_path.
+/// errors naming the JSON pointer). `base_dir` resolves height.csv_path. The document
+/// mirrors the struct, except that the LED colour is "color_bgr": [b, g, r] and the CSV
+/// path is "csv"; enums are strings ("codec": "ffv1", "foot": "A", "rotation": "+").
+///   {"id": "ci-001", "seed": 7, "duration_s": 3,
+///    "camera": {"width_px": 320, "height_px": 240, "fps": 60, "codec": "h264", ...},
+///    "nuisance": {"noise_sigma": 2, ...}, "led": {"color_bgr": [40, 40, 255], ...},
+///    "motion": {"foot": "A", "rotation": "+", "height": {"kind": "csv", "csv": "c.csv"}},
+///    "log": {"clock_drift_ppm": 50, ...}}
+/// Errors name the source and the JSON pointer: "t.json: /camera/fps: expected a number
+/// in [1, 1000], got 0" (kInvalidArgument for values, as JsonReader for types and keys).
 Result<TrialSpec> TrialSpecFromJson(const nlohmann::json& document, const std::string& source,
                                     const std::filesystem::path& base_dir);
 nlohmann::json TrialSpecToJson(const TrialSpec& spec);
@@ -199,8 +217,21 @@ struct GroundTruth {
   /// Pixel row of the foot's bottom edge at rest (subpixel), for tests.
   double foot_rest_bottom_px = 0.0;
 
+  /// The truth file. Instants are written twice, as integer ns (exact, what programs read)
+  /// and as seconds (for people; ignored on reading unless they disagree by more than
+  /// 1 us); absent values are null:
+  ///   {"format": "liftoff-synth-truth", "version": 1, "trial_id": "ci-001", "foot": "A",
+  ///    "led_on_video_ns": 1000000000, "led_on_video_s": 1.0,
+  ///    "led_first_frame": 60, "led_first_frame_fraction": 1.0,
+  ///    "liftoff_0mm_video_ns": ..., "liftoff_0mm_video_s": ..., "liftoff_0mm_rad": 0.45,
+  ///    "liftoff_1mm_video_ns": ..., "liftoff_1mm_video_s": ..., "liftoff_1mm_rad": ...,
+  ///    "px_per_mm": 1.2, "foot_rest_bottom_px": 200.5,
+  ///    "led_roi_px": {"x_px", "y_px", "width_px", "height_px"}, "foot_roi_px": {...},
+  ///    "frame_count": 180, "frame_times_ns": [0, 16666667, ...]}
   nlohmann::json ToJson() const;
 };
+/// Reads a truth file written by GroundTruth::ToJson; errors name `source` and the JSON
+/// pointer.
 Result<GroundTruth> GroundTruthFromJson(const nlohmann::json& document, const std::string& source);
 
 /// The trial's motion as functions of the clocks: what the renderer draws and the log
@@ -210,24 +241,39 @@ class Timeline {
   /// Loads the height curve (CSV when asked) and fixes the ramp offset.
   static Result<Timeline> Create(const TrialSpec& spec);
 
+  /// Video instant of the LED switch-on, the origin of the test clock (even when it lies
+  /// outside the clip).
+  int64_t led_on_origin_video_ns() const { return led_on_video_ns_; }
+  /// The LED switch-on, video clock; nullopt when the LED never switches on within the
+  /// clip (led.on_video_s outside [0, duration_s)).
+  std::optional<int64_t> LedOnVideoNs() const;
+  /// Clip length, ns.
+  int64_t duration_ns() const { return duration_ns_; }
+
   /// Test clock (s since LED on) of a video instant.
   double TestSecondsFromVideoNs(int64_t t_video_ns) const;
-  /// Device clock of a video instant (the log's clock).
+  /// Device clock of a video instant (the log's clock): led_on_device_ns + (t_video -
+  /// LED on) * (1 + clock_drift_ppm * 1e-6), rounded to the nearest ns.
   int64_t DeviceNsFromVideoNs(int64_t t_video_ns) const;
-  /// Video instant of a device-clock instant.
+  /// Video instant of a device-clock instant (the inverse, within 1 ns).
   int64_t VideoNsFromDeviceNs(int64_t t_device_ns) const;
 
-  /// Signed vertebra angle at a test-clock second, rad.
+  /// Signed vertebra angle at a test-clock second, rad: 0 before ramp_start_s, then
+  /// sense * ramp_rate * (test_s - ramp_start_s).
   double VertebraRadAt(double test_s) const;
-  /// Bending spool angle at a test-clock second, rad (0 before the bend).
+  /// Bending spool angle at a test-clock second, rad: 0 before the bend, linear from
+  /// bend_start_s to bend_end_s, `target_spool_rad` after.
   double BendSpoolRadAt(double test_s, double target_spool_rad) const;
-  /// Height of `foot` above its rest at a video instant, m (>= 0).
+  /// Height of `foot` above its rest at a video instant, m (>= 0): the lifting foot by the
+  /// height curve of |rotation|, its diagonal partner by the same curve diagonal_lag_rad
+  /// later (when the lag is > 0), the others 0.
   double FootHeightMAt(Foot foot, int64_t t_video_ns) const;
-  /// Whether the LED is on at a video instant.
+  /// Whether the LED is on at a video instant (never, when LedOnVideoNs() is nullopt).
   bool LedOnAt(int64_t t_video_ns) const;
 
   /// First video instant at which the lifting foot's height exceeds `height_m`
-  /// (nullopt when not within [0, duration]); exact to 1 ns.
+  /// (nullopt when not within [0, duration]); exact to 1 ns: the result is the first
+  /// integer ns at which FootHeightMAt(spec().motion.foot, t) > height_m.
   std::optional<int64_t> FirstVideoNsAbove(double height_m) const;
 
   const TrialSpec& spec() const { return spec_; }
@@ -235,7 +281,12 @@ class Timeline {
  private:
   TrialSpec spec_;
   std::vector<double> curve_rotation_rad_, curve_height_m_;  // CSV curve, when used
+  int64_t led_on_video_ns_ = 0;
+  int64_t duration_ns_ = 0;
+  ClockMap device_from_video_, video_from_device_;
   double HeightAtRotation(double abs_rotation_rad, bool diagonal) const;
+  double CurveHeightM(double abs_rotation_rad) const;
+  std::optional<double> FirstRotationAbove(double height_m) const;
 };
 
 }  // namespace liftoff::synth
