@@ -8,6 +8,7 @@
 
 #include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/synth_commands.h"
 
 namespace {
 
@@ -179,6 +180,17 @@ int main(int argc, char** argv) {
   journal_app->add_option("--max-records", journal.max_records, "Dump at most this many records");
   AddCalibrationFlag(journal_app, journal.calibration);
 
+  SynthCommand synth;
+  CLI::App* synth_app = app.add_subcommand(
+      "synth",
+      "Render synthetic trials (video, controller log, ground truth) from a spec or a set");
+  synth_app->add_option("spec", synth.spec_path, "Trial spec JSON (see --print-spec)");
+  synth_app->add_option("--set", synth.set_name, "Write a whole named set: ci or paper");
+  synth_app->add_option("--output,-o", synth.output_dir, "Folder for the files");
+  synth_app->add_flag("--print-spec", synth.print_spec, "Print the default spec as JSON");
+  synth_app->add_flag("--quiet,-q", synth.quiet, "No progress lines on stderr");
+  AddCalibrationFlag(synth_app, synth.calibration);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -196,6 +208,7 @@ int main(int argc, char** argv) {
     if (*emulate_app) return RunEmulate(emulate, std::cout, std::cerr);
     if (*ports_app) return RunPorts(ports, std::cout, std::cerr);
     if (*journal_app) return RunJournal(journal, std::cout, std::cerr);
+    if (*synth_app) return RunSynth(synth, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "liftoff: internal error: " << error.what() << '\n';
     return kExitInternal;

@@ -1,1 +1,112 @@
-// placeholder: being written
+#include "liftoff/cli/synth_commands.h"
+
+#include <cstdio>
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/time.h"
+#include "liftoff/synth/sets.h"
+#include "liftoff/synth/spec.h"
+#include "liftoff/synth/trial_writer.h"
+
+namespace liftoff::cli {
+namespace {
+
+std::string Fixed(double value, int decimals) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+std::string PerFrameMs(double seconds, size_t frames) {
+  return Fixed(1e3 * seconds / static_cast<double>(frames == 0 ? 1 : frames), 2) + " ms/frame";
+}
+
+// One line per trial: frames and the time spent on them.
+void PrintTrial(const synth::WrittenTrial& written, std::ostream& out) {
+  const synth::GroundTruth& truth = written.truth;
+  const size_t frames = truth.frame_times_ns.size();
+  out << truth.trial_id << ": " << frames << " frames, render "
+      << PerFrameMs(written.render_seconds, frames) << ", encode "
+      << PerFrameMs(written.encode_seconds, frames) << '\n';
+}
+
+int RunOneTrial(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
+                std::ostream& err) {
+  auto document = LoadJsonFile(command.spec_path);
+  if (!document.ok()) return ReportError(document.status(), err);
+  auto spec = synth::TrialSpecFromJson(*document, command.spec_path.string(),
+                                       command.spec_path.parent_path());
+  if (!spec.ok()) return ReportError(spec.status(), err);
+  if (!command.quiet)
+    err << "rendering " << spec->id << " into " << command.output_dir.string() << '\n';
+  auto written = synth::WriteTrial(*spec, calibration, command.output_dir);
+  if (!written.ok()) return ReportError(written.status(), err);
+
+  // what was written and the answer it holds
+  PrintTrial(*written, out);
+  const synth::GroundTruth& truth = written->truth;
+  out << "video: " << written->video_path.string() << '\n'
+      << "log: " << written->log_path.string() << '\n'
+      << "truth: " << written->truth_path.string() << '\n';
+  if (truth.led_on_video_ns && truth.led_first_frame) {
+    out << "LED on: " << FormatSeconds(*truth.led_on_video_ns) << " s (frame "
+        << *truth.led_first_frame << ", " << Fixed(truth.led_first_frame_fraction, 3)
+        << " of its exposure)\n";
+  } else {
+    out << "LED on: never within the clip\n";
+  }
+  if (truth.liftoff_1mm_video_ns && truth.liftoff_1mm_rad) {
+    out << "liftoff (1 mm): " << FormatSeconds(*truth.liftoff_1mm_video_ns) << " s, |vertebra| "
+        << Fixed(*truth.liftoff_1mm_rad, 4) << " rad\n";
+  } else {
+    out << "liftoff: the foot does not lift within the clip\n";
+  }
+  out << "calibration: " << calibration.Brief() << '\n';
+  return kExitOk;
+}
+
+int RunSet(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
+           std::ostream& err) {
+  const auto progress = [&](const synth::SetProgress& at) {
+    if (!command.quiet) err << "[" << at.index + 1 << "/" << at.count << "] " << at.id << '\n';
+  };
+  auto summary = synth::WriteSet(command.set_name, calibration, command.output_dir, progress);
+  if (!summary.ok()) return ReportError(summary.status(), err);
+  for (const synth::WrittenTrial& written : summary->trials) PrintTrial(written, out);
+  out << summary->Brief() << '\n'
+      << "manifest: " << summary->manifest_path.string() << '\n'
+      << "index: " << summary->index_path.string() << '\n'
+      << "calibration: " << calibration.Brief() << '\n';
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) {
+  // exactly one job
+  const int jobs = (command.spec_path.empty() ? 0 : 1) + (command.set_name.empty() ? 0 : 1) +
+                   (command.print_spec ? 1 : 0);
+  if (jobs != 1) {
+    err << "liftoff synth: give exactly one of SPEC.json, --set NAME or --print-spec\n";
+    return kExitUsage;
+  }
+  if (command.print_spec) {
+    out << synth::TrialSpecToJson(synth::TrialSpec{}).dump(2) << '\n';
+    return kExitOk;
+  }
+  if (command.output_dir.empty()) {
+    err << "liftoff synth: --output DIR is required with a spec or --set\n";
+    return kExitUsage;
+  }
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
+                                  : RunSet(command, *calibration, out, err);
+}
+
+}  // namespace liftoff::cli

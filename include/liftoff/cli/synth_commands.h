@@ -1,0 +1,34 @@
+// `liftoff synth`: synthetic trials (video, controller log, ground truth) from a spec,
+// or a whole named set. Same shape as commands.h: apps/liftoff/main.cc maps flags onto
+// SynthCommand; RunSynth writes results to `out`, progress and diagnostics to `err`, and
+// returns the process exit code (ExitCodeFor; docs/cli.md).
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "liftoff/cli/commands.h"
+
+namespace liftoff::cli {
+
+/// Exactly one of spec_path, set_name and print_spec:
+///   liftoff synth SPEC.json -o DIR     one trial
+///   liftoff synth --set ci -o DIR      a named set (synth/sets.h)
+///   liftoff synth --print-spec         the default spec as JSON, for editing
+struct SynthCommand {
+  /// Trial spec (JSON, docs/synth.md); relative CSV paths inside resolve against its folder.
+  std::filesystem::path spec_path;
+  /// Named set: "ci" or "paper".
+  std::string set_name;
+  /// Folder the files go to (created when missing).
+  std::filesystem::path output_dir;
+  /// Print the default TrialSpec as JSON on `out` and do nothing else.
+  bool print_spec = false;
+  /// No progress lines on `err`.
+  bool quiet = false;
+  CalibrationChoice calibration;
+};
+int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err);
+
+}  // namespace liftoff::cli
