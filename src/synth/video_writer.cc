@@ -241,7 +241,15 @@ Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::filesystem::pa
       encoder->flags |= AV_CODEC_FLAG_QSCALE;
       encoder->global_quality = FF_QP2LAMBDA * options.quality;
       break;
-    case VideoCodec::kFfv1: encoder->thread_count = 1; break;
+    case VideoCodec::kFfv1:
+      // version 3 with 4 slices encodes the slices in parallel; slices, not threads,
+      // decide the bytes, so the output stays the same on any machine
+      encoder->thread_count = 2;
+      encoder->thread_type = FF_THREAD_SLICE;
+      av_opt_set_int(encoder->priv_data, "slices", 4, 0);
+      av_opt_set_int(encoder->priv_data, "slicecrc", 1, 0);
+      encoder->level = 3;
+      break;
   }
   if (const int opened = avcodec_open2(encoder, codec, nullptr); opened < 0) {
     return UnsupportedError(DisplayPath(path) + ": cannot open the " + choice.encoder +
