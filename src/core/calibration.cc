@@ -31,44 +31,12 @@ constexpr NumberRange kGrooveRadius{.min = 0.0, .max = 0.1, .min_exclusive = tru
 constexpr NumberRange kCableLength{.min = 0.0, .max = 10.0, .min_exclusive = true};
 constexpr NumberRange kSigma{.min = -10.0, .max = 10.0};
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string DescribeRange(const NumberRange& range) {
-  const bool has_min = std::isfinite(range.min);
-  const bool has_max = std::isfinite(range.max);
-  if (has_min && has_max) {
-    return std::string("a number in ") + (range.min_exclusive ? "(" : "[") +
-           FormatNumber(range.min) + ", " + FormatNumber(range.max) +
-           (range.max_exclusive ? ")" : "]");
-  }
-  if (has_min) {
-    return std::string("a number ") + (range.min_exclusive ? "> " : ">= ") +
-           FormatNumber(range.min);
-  }
-  if (has_max) {
-    return std::string("a number ") + (range.max_exclusive ? "< " : "<= ") +
-           FormatNumber(range.max);
-  }
-  return "a finite number";
-}
-
-bool InRange(double value, const NumberRange& range) {
-  if (!std::isfinite(value)) return false;
-  const bool above_min = range.min_exclusive ? value > range.min : value >= range.min;
-  const bool below_max = range.max_exclusive ? value < range.max : value <= range.max;
-  return above_min && below_max;
-}
-
 // Collects the first problem, named by the field's JSON pointer in the file format.
 class Checker {
  public:
   void Number(const std::string& pointer, double value, const NumberRange& range) {
-    if (!InRange(value, range)) {
-      Fail(pointer, "expected " + DescribeRange(range) + ", got " + FormatNumber(value));
+    if (!InNumberRange(value, range)) {
+      Fail(pointer, "expected " + DescribeNumberRange(range) + ", got " + FormatNumber(value));
     }
   }
   void Fail(const std::string& pointer, const std::string& message) {

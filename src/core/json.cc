@@ -22,31 +22,6 @@ std::string Describe(const json& value) {
   return text;
 }
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string DescribeRange(const NumberRange& range, bool integer) {
-  std::string what = integer ? "an integer" : "a number";
-  const bool has_min = std::isfinite(range.min);
-  const bool has_max = std::isfinite(range.max);
-  if (has_min && has_max) {
-    return what + " in " + (range.min_exclusive ? "(" : "[") + FormatNumber(range.min) + ", " +
-           FormatNumber(range.max) + (range.max_exclusive ? ")" : "]");
-  }
-  if (has_min) return what + (range.min_exclusive ? " > " : " >= ") + FormatNumber(range.min);
-  if (has_max) return what + (range.max_exclusive ? " < " : " <= ") + FormatNumber(range.max);
-  return what;
-}
-
-bool InRange(double value, const NumberRange& range) {
-  const bool below = range.min_exclusive ? !(value > range.min) : !(value >= range.min);
-  const bool above = range.max_exclusive ? !(value < range.max) : !(value <= range.max);
-  return !(below || above || std::isnan(value));
-}
-
 // Line and column of a byte offset, both from 1.
 std::pair<size_t, size_t> LineColumn(std::string_view text, size_t offset) {
   size_t line = 1, column = 1;
@@ -62,6 +37,32 @@ std::pair<size_t, size_t> LineColumn(std::string_view text, size_t offset) {
 }
 
 }  // namespace
+
+std::string FormatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+std::string DescribeNumberRange(const NumberRange& range, bool integer) {
+  std::string what = integer ? "an integer" : "a number";
+  const bool has_min = std::isfinite(range.min);
+  const bool has_max = std::isfinite(range.max);
+  if (has_min && has_max) {
+    return what + " in " + (range.min_exclusive ? "(" : "[") + FormatNumber(range.min) + ", " +
+           FormatNumber(range.max) + (range.max_exclusive ? ")" : "]");
+  }
+  if (has_min) return what + (range.min_exclusive ? " > " : " >= ") + FormatNumber(range.min);
+  if (has_max) return what + (range.max_exclusive ? " < " : " <= ") + FormatNumber(range.max);
+  return what;
+}
+
+bool InNumberRange(double value, const NumberRange& range) {
+  if (!std::isfinite(value)) return false;
+  const bool above_min = range.min_exclusive ? value > range.min : value >= range.min;
+  const bool below_max = range.max_exclusive ? value < range.max : value <= range.max;
+  return above_min && below_max;
+}
 
 std::string JsonPointerEscape(std::string_view key) {
   std::string escaped;
@@ -167,8 +168,8 @@ const json* JsonReader::Raw(std::string_view key) { return Find(key, true); }
 
 bool JsonReader::CheckRange(std::string_view key, double value, const NumberRange& range,
                             bool integer) {
-  if (!InRange(value, range)) {
-    Fail(key, "expected " + DescribeRange(range, integer) + ", got " + FormatNumber(value));
+  if (!InNumberRange(value, range)) {
+    Fail(key, "expected " + DescribeNumberRange(range, integer) + ", got " + FormatNumber(value));
     return false;
   }
   return true;
@@ -178,7 +179,7 @@ std::optional<double> JsonReader::OptionalNumber(std::string_view key, const Num
   const json* value = Find(key, true);
   if (value == nullptr) return std::nullopt;
   if (!value->is_number()) {
-    Fail(key, "expected " + DescribeRange(range, false) + ", got " + Describe(*value));
+    Fail(key, "expected " + DescribeNumberRange(range, false) + ", got " + Describe(*value));
     return std::nullopt;
   }
   const double number = value->get<double>();
@@ -190,7 +191,7 @@ std::optional<int64_t> JsonReader::OptionalInteger(std::string_view key, const N
   const json* value = Find(key, true);
   if (value == nullptr) return std::nullopt;
   if (!value->is_number_integer()) {
-    Fail(key, "expected " + DescribeRange(range, true) + ", got " + Describe(*value));
+    Fail(key, "expected " + DescribeNumberRange(range, true) + ", got " + Describe(*value));
     return std::nullopt;
   }
   const int64_t number = value->get<int64_t>();
@@ -277,16 +278,16 @@ std::optional<std::vector<double>> JsonReader::OptionalNumberArray(std::string_v
     // the index is a pointer step of its own, not part of an escaped key
     const auto fail_element = [&](const std::string& got) {
       if (!shared_->first_error.ok()) return;
-      shared_->first_error = InvalidArgumentError(shared_->source + ": " + ChildPointer(key) + "/" +
-                                                  std::to_string(i) + ": expected " +
-                                                  DescribeRange(range, false) + ", got " + got);
+      shared_->first_error = InvalidArgumentError(
+          shared_->source + ": " + ChildPointer(key) + "/" + std::to_string(i) + ": expected " +
+          DescribeNumberRange(range, false) + ", got " + got);
     };
     if (!element.is_number()) {
       fail_element(Describe(element));
       return std::nullopt;
     }
     numbers.push_back(element.get<double>());
-    if (!InRange(numbers.back(), range)) {
+    if (!InNumberRange(numbers.back(), range)) {
       fail_element(FormatNumber(numbers.back()));
       return std::nullopt;
     }

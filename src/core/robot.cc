@@ -25,6 +25,16 @@ std::optional<Foot> ParseFoot(std::string_view text) {
   return std::nullopt;
 }
 
+Foot DiagonalPartner(Foot foot) {
+  switch (foot) {
+    case Foot::kA: return Foot::kD;
+    case Foot::kB: return Foot::kC;
+    case Foot::kC: return Foot::kB;
+    case Foot::kD: return Foot::kA;
+  }
+  return Foot::kA;
+}
+
 std::string_view CableGroupName(CableGroup group) {
   static constexpr std::array<std::string_view, 4> kNames = {"HT", "HB", "HR", "HL"};
   return kNames[static_cast<size_t>(group)];

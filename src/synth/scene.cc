@@ -266,16 +266,6 @@ void ApplyVignette(cv::Mat& canvas, int margin_px, const Camera& camera) {
 // ---------------------------------------------------------------------------------------
 // feet and legs
 
-Foot DiagonalPartnerOf(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return Foot::kD;
-    case Foot::kB: return Foot::kC;
-    case Foot::kC: return Foot::kB;
-    case Foot::kD: return Foot::kA;
-  }
-  return Foot::kA;
-}
-
 cv::Vec3d TapeBgr(Foot foot) {
   switch (foot) {
     case Foot::kA: return {200, 80, 20};   // blue
@@ -571,8 +561,7 @@ void SceneRenderer::Build(const Timeline& timeline) {
   const Foot lifting = spec.motion.foot;
   std::array<bool, 4> moves{};
   moves[static_cast<size_t>(lifting)] = true;
-  if (spec.motion.diagonal_lag_rad > 0)
-    moves[static_cast<size_t>(DiagonalPartnerOf(lifting))] = true;
+  if (spec.motion.diagonal_lag_rad > 0) moves[static_cast<size_t>(DiagonalPartner(lifting))] = true;
   const FootPlacement& lift_place = placements_[static_cast<size_t>(lifting)];
   foot_roi_px_ = ClippedRegion(lift_place.center_x_px - lift_place.width_px / 2 - kShakeBoundPx,
                                lift_place.bottom_px - lift_place.height_px -

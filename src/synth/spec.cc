@@ -26,45 +26,19 @@ constexpr double kPi = std::numbers::pi;
 // ---------------------------------------------------------------------------------------
 // range checks, named by the struct's field path ("camera.fps")
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string DescribeRange(const NumberRange& range, bool integer) {
-  std::string what = integer ? "an integer" : "a number";
-  const bool has_min = std::isfinite(range.min);
-  const bool has_max = std::isfinite(range.max);
-  if (has_min && has_max) {
-    return what + " in " + (range.min_exclusive ? "(" : "[") + FormatNumber(range.min) + ", " +
-           FormatNumber(range.max) + (range.max_exclusive ? ")" : "]");
-  }
-  if (has_min) return what + (range.min_exclusive ? " > " : " >= ") + FormatNumber(range.min);
-  if (has_max) return what + (range.max_exclusive ? " < " : " <= ") + FormatNumber(range.max);
-  return "a finite number";
-}
-
-bool InRange(double value, const NumberRange& range) {
-  if (!std::isfinite(value)) return false;
-  const bool above_min = range.min_exclusive ? value > range.min : value >= range.min;
-  const bool below_max = range.max_exclusive ? value < range.max : value <= range.max;
-  return above_min && below_max;
-}
-
 NumberRange Closed(double min, double max) { return {.min = min, .max = max}; }
 
 // Keeps the first problem as (field path, message).
 class Checker {
  public:
   void Number(std::string_view field, double value, const NumberRange& range) {
-    if (!InRange(value, range)) {
-      Fail(field, "expected " + DescribeRange(range, false) + ", got " + FormatNumber(value));
+    if (!InNumberRange(value, range)) {
+      Fail(field, "expected " + DescribeNumberRange(range, false) + ", got " + FormatNumber(value));
     }
   }
   void Integer(std::string_view field, double value, const NumberRange& range) {
-    if (!InRange(value, range)) {
-      Fail(field, "expected " + DescribeRange(range, true) + ", got " + FormatNumber(value));
+    if (!InNumberRange(value, range)) {
+      Fail(field, "expected " + DescribeNumberRange(range, true) + ", got " + FormatNumber(value));
     }
   }
   void Fail(std::string_view field, std::string message) {
@@ -256,16 +230,6 @@ std::optional<int64_t> ReadInstant(JsonReader& reader, const std::string& name) 
                                  " s), got " + FormatNumber(*seconds));
   }
   return ns;
-}
-
-Foot DiagonalPartner(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return Foot::kD;
-    case Foot::kB: return Foot::kC;
-    case Foot::kC: return Foot::kB;
-    case Foot::kD: return Foot::kA;
-  }
-  return Foot::kA;
 }
 
 // ---------------------------------------------------------------------------------------

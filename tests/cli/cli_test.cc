@@ -18,17 +18,13 @@
 namespace liftoff::cli {
 namespace {
 
+using liftoff::testing::CommandRun;
+using liftoff::testing::Quoted;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::SourceDir;
 using liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
-
-struct CommandRun {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
 
 CommandRun RunTableCommand(const TableCommand& command) {
   std::ostringstream out, err;
@@ -39,21 +35,9 @@ CommandRun RunTableCommand(const TableCommand& command) {
   return run;
 }
 
-// Runs the real binary; stdout and stderr captured separately.
 CommandRun RunBinary(const std::string& arguments, const ScratchDir& scratch) {
-  const std::string out_file = (scratch / "stdout.txt").string();
-  const std::string err_file = (scratch / "stderr.txt").string();
-  const std::string command = std::string("\"") + LIFTOFF_BINARY + "\" " + arguments + " >\"" +
-                              out_file + "\" 2>\"" + err_file + "\"";
-  const int status = std::system(command.c_str());
-  CommandRun run;
-  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = ReadFile(out_file);
-  run.err = ReadFile(err_file);
-  return run;
+  return liftoff::testing::RunCommand(LIFTOFF_BINARY, arguments, scratch);
 }
-
-std::string Quoted(const std::filesystem::path& path) { return "\"" + path.string() + "\""; }
 
 // A manifest with one trial whose log is `log_text` in the 2018 format.
 std::filesystem::path WriteOneTrial(const ScratchDir& scratch, const std::string& log_text,

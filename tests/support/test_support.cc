@@ -5,6 +5,8 @@
 #include <random>
 #include <sstream>
 
+#include <sys/wait.h>
+
 namespace liftoff::testing {
 
 std::filesystem::path SourceDir() {
@@ -45,6 +47,22 @@ Calibration DriveChainCalibration() {
   calibration.spur_gear_ratio = 4;
   return calibration;
 }
+
+CommandRun RunCommand(const std::filesystem::path& binary, const std::string& arguments,
+                      const ScratchDir& scratch) {
+  const std::filesystem::path out_file = scratch / "stdout.txt";
+  const std::filesystem::path err_file = scratch / "stderr.txt";
+  const std::string command = Quoted(binary) + " " + arguments + " >" + Quoted(out_file) + " 2>" +
+                              Quoted(err_file) + " </dev/null";
+  const int status = std::system(command.c_str());
+  CommandRun run;
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.out = ReadFile(out_file);
+  run.err = ReadFile(err_file);
+  return run;
+}
+
+std::string Quoted(const std::filesystem::path& path) { return "\"" + path.string() + "\""; }
 
 void WriteFile(const std::filesystem::path& path, const std::string& contents) {
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());

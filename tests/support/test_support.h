@@ -38,6 +38,19 @@ class ScratchDir {
 /// output shaft's). Name "test".
 Calibration DriveChainCalibration();
 
+/// What a command line did: its exit code and what it printed.
+struct CommandRun {
+  int code = -1;  ///< exit status; -1 when it did not exit normally
+  std::string out;
+  std::string err;
+};
+/// Runs `binary` with `arguments` (already quoted as a shell needs) through the shell,
+/// capturing standard output and error in files under `scratch`.
+CommandRun RunCommand(const std::filesystem::path& binary, const std::string& arguments,
+                      const ScratchDir& scratch);
+/// `path` in double quotes, for a shell command line.
+std::string Quoted(const std::filesystem::path& path);
+
 /// Writes `contents` to `path` byte for byte (creating parent folders).
 void WriteFile(const std::filesystem::path& path, const std::string& contents);
 /// Reads a whole file; empty when missing.

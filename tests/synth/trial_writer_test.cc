@@ -29,6 +29,8 @@
 namespace liftoff::synth {
 namespace {
 
+using liftoff::testing::CommandRun;
+using liftoff::testing::Quoted;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::WriteFile;
@@ -529,25 +531,9 @@ TEST(CiSet, SetByNameKnowsCiAndPaperOnly) {
 // ---------------------------------------------------------------------------------------
 // `liftoff synth` end to end
 
-struct CommandRun {
-  int code = -1;
-  std::string out, err;
-};
-
 CommandRun RunBinary(const std::string& arguments, const ScratchDir& scratch) {
-  const std::string out_file = (scratch / "stdout.txt").string();
-  const std::string err_file = (scratch / "stderr.txt").string();
-  const std::string command = std::string("\"") + LIFTOFF_BINARY + "\" " + arguments + " >\"" +
-                              out_file + "\" 2>\"" + err_file + "\"";
-  const int status = std::system(command.c_str());
-  CommandRun run;
-  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = ReadFile(out_file);
-  run.err = ReadFile(err_file);
-  return run;
+  return liftoff::testing::RunCommand(LIFTOFF_BINARY, arguments, scratch);
 }
-
-std::string Quoted(const std::filesystem::path& path) { return "\"" + path.string() + "\""; }
 
 TEST(SynthCommand, CiSetEndToEnd) {
   ScratchDir scratch;

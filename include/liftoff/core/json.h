@@ -47,6 +47,14 @@ struct NumberRange {
   bool max_exclusive = false;  ///< max itself is not allowed
 };
 
+/// "a number in [0, 1]", "an integer >= 1", "a number > 0", or "a number" (unbounded):
+/// what an error message says was expected.
+std::string DescribeNumberRange(const NumberRange& range, bool integer = false);
+/// Whether `value` is finite and inside `range`.
+bool InNumberRange(double value, const NumberRange& range);
+/// A number as people write it: 0.25, 1e-06, 1000.
+std::string FormatNumber(double value);
+
 /// Reads one JSON object field by field. Each getter marks its key as read; a missing
 /// required key, a wrong type or an out-of-range value records an error naming the
 /// file and the JSON pointer, and returns a default. Readers of nested objects share

@@ -22,6 +22,8 @@ std::string_view FootPosition(Foot foot);
 std::string_view FootTapeColour(Foot foot);
 /// Parses "A".."D" (exact, upper case); nullopt otherwise.
 std::optional<Foot> ParseFoot(std::string_view text);
+/// The foot diagonally opposite: A <-> D, B <-> C (the pair a twist of the spine raises).
+Foot DiagonalPartner(Foot foot);
 
 /// The four horizontal cable groups (one cable in each of the four gaps between
 /// consecutive vertebrae): top, bottom, right, left. A foot-lifting test pulls HR or HL.
