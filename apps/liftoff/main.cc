@@ -9,6 +9,7 @@
 #include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/synth_commands.h"
+#include "liftoff/core/version.h"
 
 namespace {
 
@@ -51,7 +52,7 @@ void AddTestFlags(CLI::App* app, TestChoice& test) {
 
 int main(int argc, char** argv) {
   CLI::App app{"liftoff: measure robot foot-lifting tests against simulation"};
-  app.set_version_flag("--version", std::string("liftoff 0.1.0"));
+  app.set_version_flag("--version", std::string("liftoff ") + liftoff::kVersion);
   app.require_subcommand(1);
 
   TableCommand table;

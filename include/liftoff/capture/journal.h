@@ -28,6 +28,7 @@
 #include "liftoff/core/calibration.h"
 #include "liftoff/core/controller_log.h"
 #include "liftoff/core/status.h"
+#include "liftoff/core/version.h"
 
 namespace liftoff::capture {
 
@@ -40,7 +41,7 @@ struct JournalHeader {
   /// Host time the capture began, ns since the Unix epoch.
   int64_t start_time_ns = 0;
   /// Program and version that wrote the journal.
-  std::string writer = "liftoff 0.1.0";
+  std::string writer = std::string("liftoff ") + kVersion;
 };
 
 /// What a journal record holds.
