@@ -57,4 +57,14 @@ std::optional<RotationSense> ParseRotationSense(std::string_view text) {
   return std::nullopt;
 }
 
+FootLiftingMotion PaperTableTwoMotion(Foot foot) {
+  switch (foot) {
+    case Foot::kA: return {CableGroup::kHR, RotationSense::kPositive};
+    case Foot::kB: return {CableGroup::kHR, RotationSense::kNegative};
+    case Foot::kC: return {CableGroup::kHL, RotationSense::kPositive};
+    case Foot::kD: return {CableGroup::kHL, RotationSense::kNegative};
+  }
+  return {};
+}
+
 }  // namespace liftoff

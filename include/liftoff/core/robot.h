@@ -41,4 +41,14 @@ std::string_view RotationSenseName(RotationSense sense);
 /// Parses "+" or "-".
 std::optional<RotationSense> ParseRotationSense(std::string_view text);
 
+/// The paper's Table II as printed, read by foot letter: the cable group pulled and the
+/// rotation that lift each foot (A: HR +, B: HR -, C: HL +, D: HL -). Unverified: the
+/// printed C/D positions are swapped and the 2018 logs' rotation signs disagree (A and D
+/// negative); the simulation is to settle which combination lifts which foot.
+struct FootLiftingMotion {
+  CableGroup pulled_group = CableGroup::kHR;
+  RotationSense rotation = RotationSense::kPositive;
+};
+FootLiftingMotion PaperTableTwoMotion(Foot foot);
+
 }  // namespace liftoff
