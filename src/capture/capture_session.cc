@@ -12,20 +12,11 @@
 #include "liftoff/capture/journal.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/robot.h"
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::capture {
 namespace {
-
-std::string Plural(int64_t count, std::string_view noun) {
-  return std::to_string(count) + " " + std::string(noun) + (count == 1 ? "" : "s");
-}
-
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
 
 // "115200 8N1", with " rtscts" for hardware flow control.
 std::string SettingsText(const PortSettings& settings) {
@@ -46,8 +37,8 @@ std::vector<std::string> CompareWithCalibration(const wire::HeaderFrame& header,
   const auto compare = [&](std::string_view what, uint32_t device, double calibrated) {
     if (device != 0 && std::abs(static_cast<double>(device) - calibrated) > 1e-9) {
       warnings.push_back("the device reports " + std::string(what) + " " + std::to_string(device) +
-                         ", calibration " + calibration.name + " says " + Fixed(calibrated, 3) +
-                         "; angles use the calibration's");
+                         ", calibration " + calibration.name + " says " +
+                         FormatFixed(calibrated, 3) + "; angles use the calibration's");
     }
   };
   compare("encoder counts per motor revolution", header.counts_per_motor_rev,
@@ -80,7 +71,7 @@ PortIdentity IdentifyPort(const std::string& port) {
 
 bool MayReopen(const std::string& port, const PortIdentity& before) {
   std::error_code error;
-  if (!std::filesystem::exists(port, error)) return port.rfind("usb:", 0) == 0;
+  if (!std::filesystem::exists(port, error)) return IsStableId(port);
   if (!before.pseudo_terminal) return true;
   struct stat status {};
   return ::lstat(port.c_str(), &status) == 0 && S_ISLNK(status.st_mode) &&
@@ -124,6 +115,19 @@ void StreamDecoder::Emit(LogRow row, std::vector<LogRow>& rows) {
   rows.push_back(std::move(row));
 }
 
+bool StreamDecoder::IsRestart(uint32_t sequence, uint32_t device_time_us) const {
+  if (!sequence_.last() || !last_device_us_) return false;
+  // the sequence number went back (by the tracker's reading: more than half the number
+  // space ahead) and the clock went back by more than any stale repeat could
+  const uint32_t last_sequence = *sequence_.last();
+  const uint32_t last_us = *last_device_us_;
+  const bool sequence_back =
+      sequence - (last_sequence + 1) >= (uint32_t{1} << 31) && sequence != last_sequence;
+  const bool clock_back =
+      device_time_us < last_us && last_us - device_time_us > kRestartClockStepUs;
+  return sequence_back && clock_back;
+}
+
 void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& rows) {
   const wire::Frame& frame = received.frame;
   const int64_t host_ns = received.host_time_ns;
@@ -145,9 +149,27 @@ void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& r
     case wire::FrameType::kCommand: return;  // our own commands echoed back: not data
   }
 
+  // a controller restart (sequence and clock both start again) is recognised before the
+  // stale-frame filter below, which would otherwise drop everything after it: the device
+  // clock is rebased so the log's time continues just after its last row
+  std::optional<std::string> restart;
+  if (IsRestart(sequence, device_time_us)) {
+    ++counters_.restarts;
+    restart = "controller restarted: sequence " + std::to_string(*sequence_.last()) + " -> " +
+              std::to_string(sequence) + ", device clock " +
+              FormatFixed(static_cast<double>(*last_device_us_) * 1e-6, 3) + " s -> " +
+              FormatFixed(static_cast<double>(device_time_us) * 1e-6, 3) + " s";
+    clock_.Reset();
+    sequence_.Reset();
+    const int64_t continue_ns =
+        std::max(last_row_ns_.value_or(0), last_frame_ns_.value_or(0)) + kNanosecondsPerMicrosecond;
+    clock_offset_ns_ =
+        continue_ns - static_cast<int64_t>(device_time_us) * kNanosecondsPerMicrosecond;
+  }
+
   // stale frames (device time not moving forward) are dropped before they touch the
   // sequence tracker, so a repeat after a reconnect does not fake a gap
-  const int64_t device_ns = clock_.Unwrap(device_time_us);
+  const int64_t device_ns = clock_.Unwrap(device_time_us) + clock_offset_ns_;
   const bool is_sample = frame.type == wire::FrameType::kSample;
   if ((is_sample && last_sample_ns_ && device_ns <= *last_sample_ns_) ||
       (last_row_ns_ && device_ns < *last_row_ns_)) {
@@ -162,10 +184,11 @@ void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& r
   if (reconnect_pending_) {
     reconnect_pending_ = false;
     Emit(LogEvent{marker_ns, host_ns, LogEventKind::kReconnect,
-                  "port reopened after " + Fixed(SecondsFromNs(link_down_ns_), 2) +
+                  "port reopened after " + FormatFixed(SecondsFromNs(link_down_ns_), 2) +
                       " s without link"},
          rows);
   }
+  if (restart) Emit(LogEvent{marker_ns, host_ns, LogEventKind::kNote, std::move(*restart)}, rows);
   if (const std::optional<SequenceGap> gap = sequence_.Observe(sequence)) {
     ++counters_.gaps;
     counters_.missing_frames += gap->missing;
@@ -176,6 +199,7 @@ void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& r
     Emit(LogEvent{marker_ns, host_ns, LogEventKind::kGap, std::move(detail)}, rows);
   }
   last_frame_ns_ = device_ns;
+  last_device_us_ = device_time_us;
 
   // the frame itself
   switch (frame.type) {
@@ -208,14 +232,31 @@ void AddDeviceMetadata(const wire::HeaderFrame& header, LogHeader& log_header) {
   log_header.metadata["device_spur_gear_ratio"] = std::to_string(header.spur_gear_ratio);
 }
 
+LogHeader CaptureLogHeader(const Calibration& calibration, std::string source,
+                           std::string_view port_settings, std::string_view journal_name,
+                           const std::optional<wire::HeaderFrame>& device,
+                           const std::optional<wire::CommandFrame>& start) {
+  LogHeader header;
+  header.calibration = calibration.name;
+  header.source = std::move(source);
+  header.metadata["port_settings"] = std::string(port_settings);
+  header.metadata["journal"] = std::string(journal_name);
+  if (device) {
+    header.device = device->firmware;
+    AddDeviceMetadata(*device, header);
+  }
+  if (start) AddStartMetadata(*start, header);
+  return header;
+}
+
 void AddStartMetadata(const wire::CommandFrame& start, LogHeader& log_header) {
   const auto group = static_cast<CableGroup>(start.args[0]);
   log_header.metadata["commanded_pulled_group"] =
       group == CableGroup::kHR || group == CableGroup::kHL ? std::string(CableGroupName(group))
                                                            : std::to_string(start.args[0]);
-  log_header.metadata["commanded_bend_percent"] = Fixed(start.args[1] / 10.0, 1);
-  log_header.metadata["commanded_ramp_deg"] = Fixed(start.args[2] / 1000.0, 3);
-  log_header.metadata["commanded_ramp_s"] = Fixed(start.args[3] / 1000.0, 3);
+  log_header.metadata["commanded_bend_percent"] = FormatFixed(start.args[1] / 10.0, 1);
+  log_header.metadata["commanded_ramp_deg"] = FormatFixed(start.args[2] / 1000.0, 3);
+  log_header.metadata["commanded_ramp_s"] = FormatFixed(start.args[3] / 1000.0, 3);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -263,7 +304,7 @@ Status CaptureOptions::Validate() const {
 
 std::string CaptureSummary::Brief() const {
   std::string brief = Plural(frames, "frame") + " (" + Plural(samples, "sample") + ", " +
-                      Plural(events, "event") + ") in " + Fixed(duration_s, 1) + " s, " +
+                      Plural(events, "event") + ") in " + FormatFixed(duration_s, 1) + " s, " +
                       Plural(checksum_errors, "checksum failure") + ", " + Plural(gaps, "gap");
   if (missing_frames > 0) brief += " (" + Plural(missing_frames, "frame") + " missing)";
   brief += ", " + Plural(reconnects, "reconnect");
@@ -297,16 +338,10 @@ class LogSink {
 
   // Opens the log with what is known of the device, and writes the rows that waited.
   Status Open(const StreamDecoder& decoder) {
-    LogHeader header;
-    header.calibration = calibration_.name;
-    header.source = "capture " + options_.port;
-    header.metadata["port_settings"] = SettingsText(options_.settings);
-    header.metadata["journal"] = options_.JournalPath().filename().string();
-    if (decoder.device_header()) {
-      header.device = decoder.device_header()->firmware;
-      AddDeviceMetadata(*decoder.device_header(), header);
-    }
-    if (options_.send_start) AddStartMetadata(options_.start_command, header);
+    const LogHeader header = CaptureLogHeader(
+        calibration_, "capture " + options_.port, SettingsText(options_.settings),
+        options_.JournalPath().filename().string(), decoder.device_header(),
+        options_.send_start ? std::optional(options_.start_command) : std::nullopt);
     LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options_.log_path));
     LIFTOFF_RETURN_IF_ERROR(writer_.Open(options_.log_path, header));
     for (const LogRow& row : pending_) LIFTOFF_RETURN_IF_ERROR(Write(row));
@@ -354,9 +389,7 @@ class Capture {
     header.port = options_.port;
     header.settings = SettingsText(options_.settings);
     header.start_time_ns = HostNowNs();
-    JournalWriter::Options journal_options;
-    journal_options.flush_interval_ms = options_.flush_interval_ms;
-    LIFTOFF_RETURN_IF_ERROR(journal_.Open(options_.JournalPath(), header, journal_options));
+    LIFTOFF_RETURN_IF_ERROR(journal_.Open(options_.JournalPath(), header));
 
     const Status looped = Loop();
     // whatever happened, everything received reaches the disk
@@ -364,11 +397,6 @@ class Capture {
     if (!log_.is_open()) {
       const Status opened = log_.Open(decoder_);
       if (finished.ok()) finished = opened;
-    }
-    std::vector<LogRow> none;
-    if (log_.is_open()) {
-      const Status added = log_.Add(none);
-      if (finished.ok()) finished = added;
     }
     const Status log_closed = log_.Close();
     const Status journal_closed = journal_.Close();
@@ -402,7 +430,7 @@ class Capture {
           ElapsedS() >= options_.first_frame_timeout_s) {
         stopped_by_ = "first-frame timeout";
         return TimeoutError(options_.port + ": no frame arrived within " +
-                            Fixed(options_.first_frame_timeout_s, 1) + " s (" +
+                            FormatFixed(options_.first_frame_timeout_s, 1) + " s (" +
                             Plural(decoder_.parser_stats().bytes, "byte") +
                             " received; is the baud rate right and the controller running?)");
       }

@@ -18,6 +18,8 @@
 #include <system_error>
 
 #include "liftoff/capture/serial_port.h"
+#include "liftoff/core/file.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::capture {
@@ -42,15 +44,10 @@ constexpr int64_t kDrainNs = kNanosecondsPerSecond;
 constexpr int64_t kAfterTestNs = kNanosecondsPerSecond;
 constexpr int32_t kFaultBadFrame = 1;
 
-std::string Num(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-
 // "field: expected <range>, got <value>"
 Status OutOfRange(const char* field, const char* range, double value) {
-  return InvalidArgumentError(std::string(field) + ": expected " + range + ", got " + Num(value));
+  return InvalidArgumentError(std::string(field) + ": expected " + range + ", got " +
+                              FormatNumber(value));
 }
 
 // True when lo <= value <= hi (false for NaN).
@@ -75,15 +72,13 @@ uint32_t WireMicroseconds(int64_t device_time_ns) {
 Status PointLink(const fs::path& link, const std::string& target) {
   fs::path temporary = link;
   temporary += ".tmp-" + std::to_string(::getpid());
-  ::unlink(temporary.c_str());
-  if (::symlink(target.c_str(), temporary.c_str()) != 0 ||
-      ::rename(temporary.c_str(), link.c_str()) != 0) {
-    const int error = errno;
-    ::unlink(temporary.c_str());
-    return IoError(link.string() + ": cannot point the link at " + target + ": " +
-                   std::strerror(error));
+  std::error_code error;
+  fs::remove(temporary, error);
+  fs::create_symlink(target, temporary, error);
+  if (error) {
+    return IoError(link.string() + ": cannot point the link at " + target + ": " + error.message());
   }
-  return Status::Ok();
+  return RenameIntoPlace(temporary, link);
 }
 
 Status MakeNonBlocking(int fd) {
@@ -187,8 +182,8 @@ Status ControllerModelOptions::Validate() const {
   if (largest_rad * counts_per_shaft_rad() > 1e9) {
     return InvalidArgumentError(
         "counts_per_motor_rev, gearbox_ratio, spur_gear_ratio: a test's largest angle, " +
-        Num(largest_rad) + " rad, would be " + Num(largest_rad * counts_per_shaft_rad()) +
-        " counts; expected at most 1e9");
+        FormatNumber(largest_rad) + " rad, would be " +
+        FormatNumber(largest_rad * counts_per_shaft_rad()) + " counts; expected at most 1e9");
   }
   if (firmware.size() > wire::kMaxTextBytes ||
       firmware.find_first_of(",*$\r\n") != std::string::npos) {
@@ -535,6 +530,9 @@ struct Emulator::Impl {
   std::string line;
   bool line_too_long = false;
 
+  // what link_path was last pointed at by us (empty: never)
+  std::string link_target;
+
   mutable std::mutex mutex;  // guards stats and the two lists
   EmulatorStats stats;
   std::vector<uint32_t> dropped;
@@ -546,6 +544,7 @@ Status Emulator::Impl::OpenPty() {
   LIFTOFF_RETURN_IF_ERROR(MakeNonBlocking(opened.master_fd()));
   if (!options.link_path.empty()) {
     LIFTOFF_RETURN_IF_ERROR(PointLink(options.link_path, opened.slave_path()));
+    link_target = opened.slave_path();
   }
   pty.emplace(std::move(opened));
   return Status::Ok();
@@ -708,11 +707,13 @@ void Emulator::Impl::Disconnect() {
 Emulator::Emulator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Emulator::~Emulator() {
-  // remove the link when it still names our pty
+  // remove the link when it is still the one we made (also while disconnected, when it
+  // names our closed pty), never one someone has re-pointed since
   const fs::path& link = impl_->options.link_path;
-  if (!link.empty() && impl_->pty) {
+  if (!link.empty() && !impl_->link_target.empty()) {
     std::error_code error;
-    if (fs::read_symlink(link, error) == fs::path(impl_->pty->slave_path())) {
+    if (fs::is_symlink(fs::symlink_status(link, error)) &&
+        fs::read_symlink(link, error) == fs::path(impl_->link_target)) {
       fs::remove(link, error);
     }
   }

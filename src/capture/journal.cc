@@ -12,6 +12,7 @@
 
 #include "liftoff/capture/capture_session.h"
 #include "liftoff/core/file.h"
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::capture {
@@ -23,6 +24,8 @@ constexpr uint32_t kLengthMask = 0x0FFF'FFFFu;
 constexpr int kKindShift = 28;
 constexpr uint32_t kMaxHeaderBytes = 64 * 1024;
 constexpr int kKindCount = 4;
+// Longest record payload a reader accepts; writers split longer chunks.
+constexpr uint32_t kMaxRecordBytes = 16 * 1024 * 1024;
 
 void PutU32(std::string& out, uint32_t value) {
   for (int i = 0; i < 4; ++i) out += static_cast<char>((value >> (8 * i)) & 0xFF);
@@ -86,10 +89,6 @@ Status ParseHeaderText(const std::string& text, const std::string& where, Journa
   return Status::Ok();
 }
 
-std::string Plural(int64_t count, std::string_view noun) {
-  return std::to_string(count) + " " + std::string(noun) + (count == 1 ? "" : "s");
-}
-
 // Received bytes for people: text as is, other bytes as \xNN, one frame per line.
 void PrintText(std::string_view bytes, std::ostream& out) {
   bool line_start = true;
@@ -141,10 +140,6 @@ std::string_view JournalRecordKindName(JournalRecordKind kind) {
 // writer
 
 Status JournalWriter::Options::Validate() const {
-  if (!(flush_interval_ms > 0.0)) {
-    return InvalidArgumentError("journal flush_interval_ms: expected > 0, got " +
-                                std::to_string(flush_interval_ms));
-  }
   if (flush_bytes == 0) return InvalidArgumentError("journal flush_bytes: expected > 0, got 0");
   return Status::Ok();
 }
@@ -179,7 +174,7 @@ Status JournalWriter::Append(std::span<const uint8_t> bytes, int64_t host_time_n
   // longer chunks are split: the length field holds 28 bits
   size_t offset = 0;
   do {
-    const size_t length = std::min<size_t>(bytes.size() - offset, kLengthMask);
+    const size_t length = std::min<size_t>(bytes.size() - offset, kMaxRecordBytes);
     PutI64(buffer_, host_time_ns);
     PutU32(buffer_, static_cast<uint32_t>(length) | (static_cast<uint32_t>(kind) << kKindShift));
     buffer_.append(reinterpret_cast<const char*>(bytes.data() + offset), length);
@@ -187,12 +182,8 @@ Status JournalWriter::Append(std::span<const uint8_t> bytes, int64_t host_time_n
   } while (offset < bytes.size());
   if (kind == JournalRecordKind::kReceived) bytes_received_ += static_cast<int64_t>(bytes.size());
 
-  // hand to the OS when enough is buffered or enough time has passed
-  const double since_flush_ms =
-      static_cast<double>(MonotonicNowNs() - last_flush_ns_) / kNanosecondsPerMillisecond;
-  if (buffer_.size() >= options_.flush_bytes || since_flush_ms >= options_.flush_interval_ms) {
-    return Flush();
-  }
+  // hand to the OS when enough is buffered (the owner flushes on its timer)
+  if (buffer_.size() >= options_.flush_bytes) return Flush();
   return Status::Ok();
 }
 
@@ -220,7 +211,6 @@ Status JournalWriter::WriteBuffered() {
 
 Status JournalWriter::Flush() {
   if (!is_open()) return Status::Ok();
-  last_flush_ns_ = MonotonicNowNs();
   return WriteBuffered();
 }
 
@@ -245,7 +235,10 @@ JournalReader::~JournalReader() {
 }
 
 Status JournalReader::Open(const std::filesystem::path& path) {
-  if (file_ != nullptr) std::fclose(file_);
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    file_ = nullptr;  // a failed Open below must not leave a dangling handle to close again
+  }
   path_ = path;
   header_ = JournalHeader{};
   status_ = Status::Ok();
@@ -304,6 +297,15 @@ bool JournalReader::Next(JournalChunk& chunk) {
   if (kind >= kKindCount) {
     status_ = ParseError(path_.string() + ": byte " + std::to_string(offset_) +
                          ": unknown record kind " + std::to_string(kind) + " (expected 0..3)");
+    return false;
+  }
+  // a corrupt length must not make us allocate up to 256 MiB: writers split chunks
+  // longer than kMaxRecordBytes (a plausible length past the end of the file is a
+  // cut-off last record, found by the read below)
+  if (length > kMaxRecordBytes) {
+    status_ = ParseError(path_.string() + ": byte " + std::to_string(offset_) + ": record length " +
+                         std::to_string(length) + " exceeds " + std::to_string(kMaxRecordBytes) +
+                         " (corrupt journal)");
     return false;
   }
   chunk.host_time_ns = GetI64(head);
@@ -372,14 +374,9 @@ Result<JournalReplay> ReplayJournal(const std::filesystem::path& path,
 
   // the log
   ControllerLog& log = replay.log;
-  log.header.calibration = calibration.name;
-  log.header.source =
-      "replay " + path.filename().string() + " (capture " + reader.header().port + ")";
-  if (decoder.device_header()) {
-    log.header.device = decoder.device_header()->firmware;
-    AddDeviceMetadata(*decoder.device_header(), log.header);
-  }
-  if (start) AddStartMetadata(*start, log.header);
+  log.header = CaptureLogHeader(
+      calibration, "replay " + path.filename().string() + " (capture " + reader.header().port + ")",
+      reader.header().settings, path.filename().string(), decoder.device_header(), start);
   for (LogRow& row : rows) {
     if (auto* sample = std::get_if<LogSample>(&row)) {
       log.samples.push_back(std::move(*sample));

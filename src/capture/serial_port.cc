@@ -518,13 +518,15 @@ Result<std::unique_ptr<SerialPort>> OpenTermiosPort(const std::filesystem::path&
   return std::unique_ptr<SerialPort>(std::move(port));
 }
 
+bool IsStableId(std::string_view port) { return ToLower(std::string(port.substr(0, 4))) == "usb:"; }
+
 Result<std::unique_ptr<SerialPort>> OpenSerialPort(const std::string& port,
                                                    const PortSettings& settings,
                                                    const std::filesystem::path& console_list_path) {
   LIFTOFF_RETURN_IF_ERROR(settings.Validate());
   // a stable id names a device path
   std::string device = port;
-  if (ToLower(port).rfind("usb:", 0) == 0) {
+  if (IsStableId(port)) {
     LIFTOFF_ASSIGN_OR_RETURN(device, DeviceForStableId(port));
   }
   // the device itself, through any symlinks

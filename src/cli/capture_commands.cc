@@ -16,6 +16,7 @@
 #include "liftoff/capture/journal.h"
 #include "liftoff/capture/serial_port.h"
 #include "liftoff/core/robot.h"
+#include "liftoff/core/text.h"
 
 namespace liftoff::cli {
 namespace {
@@ -54,12 +55,6 @@ class ScopedStopSignals {
   struct sigaction old_term_ {};
 };
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 // TestChoice as the emulator's TestParameters (kInvalidArgument naming the flag).
 Result<capture::TestParameters> TestParametersFrom(const TestChoice& choice) {
   const std::optional<CableGroup> group = ParseCableGroup(choice.pulled_group);
@@ -80,13 +75,13 @@ Result<capture::TestParameters> TestParametersFrom(const TestChoice& choice) {
 
 // "  12.3 s  12034 frames  1000/s  0 checksum failures  0 gaps  LED on  vertebra 0.4321 rad"
 std::string StatusText(const capture::CaptureStatus& status) {
-  std::string text = Fixed(status.elapsed_s, 1) + " s  " + std::to_string(status.frames) +
-                     " frames  " + Fixed(status.rate_hz, 0) + "/s  " +
+  std::string text = FormatFixed(status.elapsed_s, 1) + " s  " + std::to_string(status.frames) +
+                     " frames  " + FormatFixed(status.rate_hz, 0) + "/s  " +
                      std::to_string(status.checksum_errors) + " checksum failures  " +
                      std::to_string(status.gaps) + " gaps  LED " +
                      (status.led_on ? (*status.led_on ? "on " : "off") : "?  ");
   if (!std::isnan(status.last_vertebra_rad)) {
-    text += "  vertebra " + Fixed(status.last_vertebra_rad, 4) + " rad";
+    text += "  vertebra " + FormatFixed(status.last_vertebra_rad, 4) + " rad";
   }
   if (!status.connected) text += "  (port gone: waiting for it)";
   return text;
@@ -184,15 +179,17 @@ int RunEmulate(const EmulateCommand& command, std::ostream& out, std::ostream& e
   options.duration_s = command.duration_s;
   options.exit_after_test = !command.keep_running;
 
+  // the handlers first: a script that reads the port line below may signal at once, and
+  // the stop must then end the run cleanly (removing the link) rather than kill us
+  ScopedStopSignals signals(command.handle_signals);
   auto emulator = capture::Emulator::Create(options);
   if (!emulator.ok()) return ReportError(emulator.status(), err);
   // the port path is the one line on stdout, at once: scripts read it to connect
   out << (*emulator)->port_path().string() << std::endl;
   err << "emulating a controller on " << (*emulator)->port_path().string() << " at "
-      << Fixed(command.rate_hz, 0) << " Hz" << (command.autostart ? " (autostart)" : "")
+      << FormatFixed(command.rate_hz, 0) << " Hz" << (command.autostart ? " (autostart)" : "")
       << "; Ctrl-C stops\n";
 
-  ScopedStopSignals signals(command.handle_signals);
   const Status ran = (*emulator)->Run(g_stop_requested);
   err << "emulator: " << (*emulator)->stats().Brief() << '\n';
   if (!ran.ok()) return ReportError(ran, err);

@@ -764,6 +764,30 @@ TEST(Emulator, DisconnectHangsUpAndReturnsOnANewPty) {
   EXPECT_FALSE(fs::exists(fs::symlink_status(options.link_path)));
 }
 
+TEST(Emulator, RemovesItsLinkWhenStoppedDuringADisconnect) {
+  testing::ScratchDir scratch;
+  EmulatorOptions options = FastOptions();
+  options.rate_hz = 2000;
+  options.link_path = scratch / "controller";
+  options.disconnect_at_s = 0.05;
+  options.disconnect_for_s = 60;  // still disconnected when stopped
+  auto emulator = Emulator::Create(options);
+  ASSERT_TRUE(emulator.ok()) << emulator.status().ToString();
+  {
+    Running running(**emulator);
+    const int64_t give_up_ns = MonotonicNowNs() + 3 * kSecond;
+    while ((*emulator)->stats().disconnects == 0 && MonotonicNowNs() < give_up_ns) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ASSERT_EQ((*emulator)->stats().disconnects, 1);
+    ASSERT_TRUE(running.Join().ok());
+  }
+  // the link still names the closed pty: ours, so it goes with the emulator
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(options.link_path)));
+  emulator->reset();
+  EXPECT_FALSE(fs::exists(fs::symlink_status(options.link_path)));
+}
+
 TEST(Emulator, StallDelaysFramesWithoutLosingThem) {
   EmulatorOptions options = FastOptions();
   options.rate_hz = 2000;

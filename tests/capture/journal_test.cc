@@ -165,7 +165,6 @@ TEST(Journal, HandsBytesToTheOperatingSystemOnceEnoughAreBuffered) {
   ScratchDir dir;
   JournalWriter writer;
   JournalWriter::Options options;
-  options.flush_interval_ms = 1e9;  // only the byte threshold
   options.flush_bytes = 100;
   ASSERT_TRUE(writer.Open(dir / "a.journal", TestHeader(), options).ok());
   const size_t header_size = ReadFile(dir / "a.journal").size();
@@ -244,6 +243,50 @@ TEST(Journal, ErrorsNameTheFileAndWhere) {
   EXPECT_EQ(reader.status().code(), StatusCode::kParse);
   EXPECT_THAT(reader.status().message(), HasSubstr("kind.journal: byte 8: unknown record kind 9"));
   EXPECT_EQ(ReplayJournal(dir / "kind.journal", DriveChainCalibration()).status().code(),
+            StatusCode::kParse);
+}
+
+TEST(Journal, ReaderReopenedAfterAFailedOpenClosesItsFileOnce) {
+  ScratchDir dir;
+  WriteJournal(dir / "a.journal", {"first\n"});
+  JournalReader reader;
+  ASSERT_TRUE(reader.Open(dir / "a.journal").ok());
+  // the valid file is closed here; the failed opens must not close it again (a double
+  // fclose, which ASan reports as a double free), nor must the destructor
+  EXPECT_EQ(reader.Open(dir / "missing.journal").code(), StatusCode::kNotFound);
+  EXPECT_EQ(reader.Open(dir / "missing2.journal").code(), StatusCode::kNotFound);
+  JournalChunk chunk;
+  EXPECT_FALSE(reader.Next(chunk));
+  // and it still reads a journal afterwards
+  ASSERT_TRUE(reader.Open(dir / "a.journal").ok());
+  ASSERT_TRUE(reader.Next(chunk));
+  EXPECT_EQ(chunk.bytes, "first\n");
+}
+
+TEST(Journal, CorruptRecordLengthIsAParseErrorNamingTheByte) {
+  ScratchDir dir;
+  WriteJournal(dir / "a.journal", {"first\n", "second\n"});
+  std::string whole = ReadFile(dir / "a.journal");
+  // the second record's length field: 0x0FFFFFFF (256 MiB), far past the 16 MiB cap
+  JournalReader probe;
+  ASSERT_TRUE(probe.Open(dir / "a.journal").ok());
+  JournalChunk chunk;
+  ASSERT_TRUE(probe.Next(chunk));
+  const auto second = static_cast<size_t>(probe.offset());
+  whole.replace(second + 8, 4, std::string("\xff\xff\xff\x0f", 4));
+  WriteFile(dir / "corrupt.journal", whole);
+
+  JournalReader reader;
+  ASSERT_TRUE(reader.Open(dir / "corrupt.journal").ok());
+  ASSERT_TRUE(reader.Next(chunk));
+  EXPECT_EQ(chunk.bytes, "first\n");
+  EXPECT_FALSE(reader.Next(chunk));
+  EXPECT_FALSE(reader.truncated());
+  EXPECT_EQ(reader.status().code(), StatusCode::kParse);
+  EXPECT_THAT(reader.status().message(),
+              HasSubstr("corrupt.journal: byte " + std::to_string(second) +
+                        ": record length 268435455 exceeds 16777216"));
+  EXPECT_EQ(ReplayJournal(dir / "corrupt.journal", DriveChainCalibration()).status().code(),
             StatusCode::kParse);
 }
 
@@ -366,6 +409,66 @@ TEST(Journal, ReplayMarksTheReconnectAndRecordsTheStartCommand) {
   EXPECT_EQ(log.header.metadata.at("commanded_bend_percent"), "75.0");
   EXPECT_EQ(log.header.metadata.at("commanded_ramp_deg"), "-45.000");
   EXPECT_EQ(log.header.metadata.at("commanded_ramp_s"), "20.000");
+}
+
+TEST(Journal, ReplayKeepsRowsComingAfterAControllerRestart) {
+  ScratchDir dir;
+  // the controller runs for 5 s, restarts (sequence and clock from 0), runs its test to
+  // the end; a stale repeat of the last frame before the restart is still dropped
+  const std::string before = Header(0, 100) + Sample(1, 4'000'000, false, 0, 0) +
+                             Sample(2, 5'000'000, true, 0, 0) + Sample(2, 5'000'000, true, 0, 0);
+  const std::string after = Header(0, 50) + Sample(1, 1000, false, 0, 0) +
+                            Event(2, 1500, wire::EventKind::kTestStart, 0) +
+                            Sample(3, 2000, true, 0, 0) + Sample(5, 4000, true, 0, 0) +
+                            Event(6, 4500, wire::EventKind::kTestEnd, 0);
+  WriteJournal(dir / "a.journal", {before, after});
+  auto replay = ReplayJournal(dir / "a.journal", DriveChainCalibration());
+  ASSERT_TRUE(replay.ok()) << replay.status().ToString();
+  const ControllerLog& log = replay->log;
+  std::vector<uint32_t> sequences;
+  for (const LogSample& sample : log.samples) sequences.push_back(*sample.sequence);
+  ASSERT_THAT(sequences, ::testing::ElementsAre(1u, 2u, 1u, 3u, 5u));
+  EXPECT_EQ(replay->duplicates, 1);
+  // time continues after the last row: the restart's header frame lands 1 us after it
+  const int64_t restart_ns = 5'000'000'000 + 1'000;
+  EXPECT_EQ(log.samples[2].device_time_ns, restart_ns + 950'000);
+  EXPECT_EQ(log.samples[4].device_time_ns, restart_ns + 3'950'000);
+  for (size_t i = 1; i < log.samples.size(); ++i) {
+    EXPECT_GT(log.samples[i].device_time_ns, log.samples[i - 1].device_time_ns);
+  }
+  // a note marks the restart; the gap after it is counted from the new sequence
+  std::vector<LogEventKind> kinds;
+  for (const LogEvent& event : log.events) kinds.push_back(event.kind);
+  ASSERT_THAT(kinds, ::testing::ElementsAre(LogEventKind::kNote, LogEventKind::kTestStart,
+                                            LogEventKind::kGap, LogEventKind::kTestEnd));
+  EXPECT_EQ(log.events[0].detail,
+            "controller restarted: sequence 2 -> 0, device clock 5.000 s -> 0.000 s");
+  EXPECT_EQ(log.events[2].detail, "1 frame, sequence 4");
+  EXPECT_EQ(replay->gaps, 1);
+  EXPECT_EQ(log.events[3].device_time_ns, restart_ns + 4'450'000);
+
+  // the live decoder sees the test end after the restart (a capture stops there)
+  const Calibration calibration = DriveChainCalibration();
+  StreamDecoder decoder(calibration);
+  std::vector<LogRow> rows;
+  decoder.Feed(Bytes(before), kStartNs, rows);
+  EXPECT_FALSE(decoder.test_ended());
+  decoder.Feed(Bytes(after), kStartNs + 1'000'000, rows);
+  EXPECT_TRUE(decoder.test_ended());
+  EXPECT_EQ(decoder.counters().restarts, 1);
+  EXPECT_EQ(rows.size(), log.samples.size() + log.events.size());
+}
+
+TEST(Journal, ReplayHeaderMatchesTheLiveCapturesHeader) {
+  ScratchDir dir;
+  WriteJournal(dir / "cap.journal", {Header(0, 100) + Sample(1, 1000, false, 0, 0)});
+  auto replay = ReplayJournal(dir / "cap.journal", DriveChainCalibration());
+  ASSERT_TRUE(replay.ok()) << replay.status().ToString();
+  const LogHeader& header = replay->log.header;
+  EXPECT_EQ(header.metadata.at("port_settings"), "115200 8N1");
+  EXPECT_EQ(header.metadata.at("journal"), "cap.journal");
+  EXPECT_EQ(header.device, "test-fw 2.1");
+  EXPECT_EQ(header.metadata.at("device_gearbox_ratio"), "1000");
 }
 
 TEST(Journal, ReplayEqualsTheLogOfTheSameBytesFedAtOnce) {

@@ -154,6 +154,15 @@ TEST(SerialPort, OpenRejectsInvalidSettingsBeforeTouchingTheDevice) {
 // ---------------------------------------------------------------------------------------
 // Pseudo-terminals
 
+TEST(SerialPort, RecognisesStableIdsInAnyCase) {
+  EXPECT_TRUE(IsStableId("usb:2341:0043:ABC"));
+  EXPECT_TRUE(IsStableId("USB:2341:0043"));
+  EXPECT_TRUE(IsStableId("Usb:"));
+  EXPECT_FALSE(IsStableId("/dev/ttyACM0"));
+  EXPECT_FALSE(IsStableId("usb"));
+  EXPECT_FALSE(IsStableId(""));
+}
+
 TEST(SerialPort, RecognisesPseudoTerminals) {
   PseudoTerminal terminal = OpenTerminal();
   testing::ScratchDir scratch;

@@ -35,6 +35,10 @@ using LogRow = std::variant<LogSample, LogEvent>;
 /// frame after it. Frames whose device time does not move forward (a sample not later than
 /// the last sample, an event earlier than the last row: stale frames repeated after a
 /// reconnect) are dropped and counted, so the log's samples stay strictly increasing.
+/// A controller restart (its sequence number goes back and its clock goes back by more
+/// than kRestartClockStepUs) is not stale: the device clock is rebased so time continues
+/// just after the last row, a `note` event "controller restarted: ..." marks it, and
+/// rows (TEST_END included) keep coming.
 class StreamDecoder {
  public:
   /// Counters beyond the parser's own (parser_stats()).
@@ -49,7 +53,13 @@ class StreamDecoder {
     int64_t duplicates = 0;
     /// Times the link came back after being lost.
     int64_t reconnects = 0;
+    /// Times the controller restarted (sequence and clock started again).
+    int64_t restarts = 0;
   };
+
+  /// A step back of the device clock longer than this, us, together with a step back of
+  /// the sequence number, is a controller restart rather than a stale repeat.
+  static constexpr uint32_t kRestartClockStepUs = 1'000'000;
 
   /// `calibration` converts counts into angles; it must outlive the decoder.
   explicit StreamDecoder(const Calibration& calibration);
@@ -76,6 +86,7 @@ class StreamDecoder {
 
  private:
   void Accept(const ReceivedFrame& received, std::vector<LogRow>& rows);
+  bool IsRestart(uint32_t sequence, uint32_t device_time_us) const;
   void Emit(LogRow row, std::vector<LogRow>& rows);
 
   const Calibration* calibration_;
@@ -85,9 +96,11 @@ class StreamDecoder {
   std::vector<ReceivedFrame> frames_;  // scratch, reused
   Counters counters_;
   std::optional<wire::HeaderFrame> device_header_;
-  std::optional<int64_t> last_frame_ns_;   // device time of the last accepted frame
-  std::optional<int64_t> last_sample_ns_;  // ... of the last sample row
-  std::optional<int64_t> last_row_ns_;     // ... of the last row of any kind
+  std::optional<int64_t> last_frame_ns_;    // device time of the last accepted frame
+  std::optional<int64_t> last_sample_ns_;   // ... of the last sample row
+  std::optional<int64_t> last_row_ns_;      // ... of the last row of any kind
+  std::optional<uint32_t> last_device_us_;  // raw device clock of the last accepted frame
+  int64_t clock_offset_ns_ = 0;             // added to the device clock since a restart
   std::optional<int64_t> link_lost_host_ns_;
   bool reconnect_pending_ = false;
   int64_t link_down_ns_ = 0;
@@ -100,6 +113,16 @@ class StreamDecoder {
 /// the commanded start parameters as commanded_* keys (when a start was sent).
 void AddDeviceMetadata(const wire::HeaderFrame& header, LogHeader& log_header);
 void AddStartMetadata(const wire::CommandFrame& start, LogHeader& log_header);
+
+/// The header of a capture's log, built alike by live capture and ReplayJournal (so a
+/// replayed log's header matches the live one but for its source): the calibration's
+/// name, `source`, the port settings ("115200 8N1") and journal file name as metadata,
+/// the device's header frame (firmware, device_* keys) and the start command
+/// (commanded_* keys) when known.
+LogHeader CaptureLogHeader(const Calibration& calibration, std::string source,
+                           std::string_view port_settings, std::string_view journal_name,
+                           const std::optional<wire::HeaderFrame>& device,
+                           const std::optional<wire::CommandFrame>& start);
 
 struct CaptureOptions {
   /// Port to read: a device path ("/dev/ttyACM0"), a stable symlink

@@ -68,10 +68,9 @@ struct JournalChunk {
 class JournalWriter {
  public:
   struct Options {
-    /// Buffered bytes are handed to the operating system at least this often, ms, so a
-    /// crash of the process loses nothing older. (Checked on each append.)
-    double flush_interval_ms = 100.0;
-    /// ... and whenever this many bytes are buffered, bytes.
+    /// Buffered bytes are handed to the operating system whenever this many are
+    /// buffered, bytes. Flushing on a timer is the owner's job (call Flush(): a capture
+    /// does so every flush_interval_ms), so a crash of the process loses nothing older.
     size_t flush_bytes = 64 * 1024;
 
     Status Validate() const;
@@ -90,7 +89,7 @@ class JournalWriter {
     return Open(path, header, Options{});
   }
   /// Appends one record (received bytes unless told otherwise). Empty received chunks
-  /// are skipped. Flushes when the interval or the byte threshold has passed.
+  /// are skipped. Flushes when the byte threshold is reached.
   Status Append(std::span<const uint8_t> bytes, int64_t host_time_ns,
                 JournalRecordKind kind = JournalRecordKind::kReceived);
   /// Appends a link record with a note for people ("read failed: device gone").
@@ -112,7 +111,6 @@ class JournalWriter {
   Options options_;
   int fd_ = -1;
   std::string buffer_;
-  int64_t last_flush_ns_ = 0;  // monotonic clock
   int64_t bytes_received_ = 0;
 };
 
@@ -131,8 +129,9 @@ class JournalReader {
   const JournalHeader& header() const { return header_; }
 
   /// The next record; false at the end of the file or at a cut-off last record (then
-  /// truncated() is true). A record with an unknown kind or an absurd length is a
-  /// kParse error naming the byte offset, reported through status().
+  /// truncated() is true). A record with an unknown kind or a length over 16 MiB (more
+  /// than any writer puts in one record: a corrupt journal) is a kParse error naming the
+  /// byte offset, reported through status().
   bool Next(JournalChunk& chunk);
   /// The error that stopped Next, if any (OK at a clean or truncated end).
   const Status& status() const { return status_; }

@@ -20,6 +20,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "liftoff/core/status.h"
@@ -109,6 +110,11 @@ class SerialPort {
   /// The device path that was opened (symlinks resolved), e.g. "/dev/ttyACM0".
   virtual const std::string& name() const = 0;
 };
+
+/// Whether `port` is a stable id ("usb:2341:0043:<serial>", any case) rather than a
+/// path: OpenSerialPort looks it up in ListPorts, and it may name a device that is
+/// absent for now (unplugged) and comes back.
+bool IsStableId(std::string_view port);
 
 /// Opens `port`: a device path ("/dev/ttyACM0", or a symlink such as
 /// /dev/serial/by-id/...), or a stable id from ListPorts ("usb:2341:0043:<serial>"; a
