@@ -1,6 +1,5 @@
 #include "liftoff/cli/synth_commands.h"
 
-#include <cstdio>
 #include <ostream>
 #include <string>
 
@@ -8,6 +7,7 @@
 
 #include "cli_common.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 #include "liftoff/synth/sets.h"
 #include "liftoff/synth/spec.h"
@@ -16,14 +16,9 @@
 namespace liftoff::cli {
 namespace {
 
-std::string Fixed(double value, int decimals) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
-}
-
 std::string PerFrameMs(double seconds, size_t frames) {
-  return Fixed(1e3 * seconds / static_cast<double>(frames == 0 ? 1 : frames), 2) + " ms/frame";
+  return FormatFixed(1e3 * seconds / static_cast<double>(frames == 0 ? 1 : frames), 2) +
+         " ms/frame";
 }
 
 // One line per trial: frames and the time spent on them.
@@ -55,14 +50,14 @@ int RunOneTrial(const SynthCommand& command, const Calibration& calibration, std
       << "truth: " << written->truth_path.string() << '\n';
   if (truth.led_on_video_ns && truth.led_first_frame) {
     out << "LED on: " << FormatSeconds(*truth.led_on_video_ns) << " s (frame "
-        << *truth.led_first_frame << ", " << Fixed(truth.led_first_frame_fraction, 3)
+        << *truth.led_first_frame << ", " << FormatFixed(truth.led_first_frame_fraction, 3)
         << " of its exposure)\n";
   } else {
     out << "LED on: never within the clip\n";
   }
   if (truth.liftoff_1mm_video_ns && truth.liftoff_1mm_rad) {
     out << "liftoff (1 mm): " << FormatSeconds(*truth.liftoff_1mm_video_ns) << " s, |vertebra| "
-        << Fixed(*truth.liftoff_1mm_rad, 4) << " rad\n";
+        << FormatFixed(*truth.liftoff_1mm_rad, 4) << " rad\n";
   } else {
     out << "liftoff: the foot does not lift within the clip\n";
   }

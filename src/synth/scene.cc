@@ -456,8 +456,7 @@ void SceneRenderer::Build(const Timeline& timeline) {
   const TrialSpec& spec = timeline.spec();
   width_px_ = spec.camera.width_px;
   height_px_ = spec.camera.height_px;
-  exposure_ns_ = std::max<int64_t>(1, NsFromSeconds(spec.camera.exposure_s));
-  led_on_ns_ = timeline.LedOnVideoNs();
+  exposure_ns_ = ExposureNs(spec.camera);
   const int margin = kMarginPx;
   const Camera camera = MakeCamera(width_px_, height_px_);
   const uint64_t salt = SeedFor(spec.seed, kTextureStream);
@@ -726,10 +725,7 @@ void SceneRenderer::ComposeLed(double fraction, cv::Mat& canvas) const {
 }
 
 double SceneRenderer::LedOnFraction(int64_t t_video_ns) const {
-  if (!led_on_ns_) return 0.0;
-  const int64_t on_ns =
-      std::clamp(t_video_ns + exposure_ns_ - *led_on_ns_, int64_t{0}, exposure_ns_);
-  return static_cast<double>(on_ns) / static_cast<double>(exposure_ns_);
+  return timeline_.LedOnFractionOfExposure(t_video_ns);
 }
 
 cv::Point2d SceneRenderer::ShakeOffsetPx(int64_t frame_index) {

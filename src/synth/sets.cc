@@ -14,6 +14,7 @@
 
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 #include "liftoff/synth/video_writer.h"
 
@@ -38,10 +39,6 @@ double PaperLiftoffRad(Foot foot) {
   }
   return 0.45;
 }
-RotationSense PaperRotation(Foot foot) {
-  return foot == Foot::kA || foot == Foot::kC ? RotationSense::kPositive : RotationSense::kNegative;
-}
-
 // Rotation at which a parametric curve reaches 1 mm, rad.
 double OneMillimetreRad(const HeightCurveSpec& curve) {
   return curve.liftoff_rad + std::pow(0.001 / curve.gain_m, 1.0 / curve.exponent);
@@ -84,7 +81,7 @@ TrialSpec CiTrial(int number, const std::string& what, Foot foot) {
   spec.id = id + what;
   spec.seed = 1000 + static_cast<uint64_t>(number);
   spec.motion.foot = foot;
-  spec.motion.rotation = PaperRotation(foot);
+  spec.motion.rotation = PaperTableTwoMotion(foot).rotation;
   spec.motion.height.liftoff_rad = PaperLiftoffRad(foot);
   return spec;
 }
@@ -112,12 +109,6 @@ std::string CiHeightCurveCsv() {
     std::snprintf(row, sizeof row, "%.2f,%.7f\n", rotation_rad, height_m);
     text += row;
   }
-  return text;
-}
-
-std::string FormatFixed(double value, int decimals) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
   return text;
 }
 
@@ -410,7 +401,7 @@ std::vector<InvalidInput> CiInvalidInputs() {
     input.id = "invalid-foot-never-lifts";
     input.kind = InvalidInput::Kind::kRendered;
     input.expected_error = StatusCode::kNotFound;
-    input.what = "the foot never lifts (the clip ends at 0.05 rad)";
+    input.what = "the foot never lifts (the clip ends at 0.06 rad)";
     input.spec = CiTrial(0, "", Foot::kB);
     input.spec.motion.ramp_rate_rad_per_s = 0.05;
     input.spec.duration_s = 2.0;
@@ -512,7 +503,7 @@ Result<std::vector<TrialSpec>> SetByName(std::string_view name) {
       spec.seed = 100 + static_cast<uint64_t>(foot);
       spec.camera.codec = VideoCodec::kH264;
       spec.motion.foot = foot;
-      spec.motion.rotation = PaperRotation(foot);
+      spec.motion.rotation = PaperTableTwoMotion(foot).rotation;
       spec.motion.height.liftoff_rad = PaperLiftoffRad(foot);
       spec.duration_s = FitDuration(spec, OneMillimetreRad(spec.motion.height), 1.0);
       set.push_back(spec);

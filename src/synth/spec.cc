@@ -152,6 +152,12 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
   // the log
   const LogSpec& log = spec.log;
   check.Integer("log.led_on_device_ns", static_cast<double>(log.led_on_device_ns), Closed(0, 1e15));
+  if (!log.led_event && log.led_on_device_ns != 0) {
+    check.Fail("log.led_on_device_ns",
+               "expected 0 when log.led_event is false (the log's device clock then starts at "
+               "the LED switch-on), got " +
+                   std::to_string(log.led_on_device_ns));
+  }
   check.Number("log.clock_drift_ppm", log.clock_drift_ppm, Closed(-1000, 1000));
   check.Number("log.rate_hz", log.rate_hz, Closed(1, 10000));
   if (check.ok()) check.Number("log.jitter_s", log.jitter_s, Closed(0, 0.5 / log.rate_hz));
@@ -615,7 +621,6 @@ Result<GroundTruth> GroundTruthFromJson(const json& document, const std::string&
   } else {
     for (size_t i = 0; i < times->size(); ++i) {
       const json& time = (*times)[i];
-      const std::string key = "frame_times_ns/" + std::to_string(i);
       if (!time.is_number_integer()) {
         root.Fail("frame_times_ns",
                   "expected integer ns, got " + time.dump() + " at index " + std::to_string(i));
@@ -665,10 +670,25 @@ Result<Timeline> Timeline::Create(const TrialSpec& spec) {
   return timeline;
 }
 
-std::optional<int64_t> Timeline::LedOnVideoNs() const {
-  if (spec_.led.on_video_s < 0 || led_on_video_ns_ >= duration_ns_) return std::nullopt;
-  return led_on_video_ns_;
+int64_t ExposureNs(const CameraSpec& camera) {
+  return std::max<int64_t>(1, NsFromSeconds(camera.exposure_s));
 }
+
+std::optional<int64_t> LedOnVideoNs(const TrialSpec& spec) {
+  const int64_t led_ns = NsFromSeconds(spec.led.on_video_s);
+  if (spec.led.on_video_s < 0 || led_ns >= NsFromSeconds(spec.duration_s)) return std::nullopt;
+  return led_ns;
+}
+
+double LedOnFractionOfExposure(const TrialSpec& spec, int64_t t_frame_ns) {
+  const std::optional<int64_t> led_ns = LedOnVideoNs(spec);
+  if (!led_ns) return 0.0;
+  const int64_t exposure_ns = ExposureNs(spec.camera);
+  const int64_t on_ns = std::clamp(t_frame_ns + exposure_ns - *led_ns, int64_t{0}, exposure_ns);
+  return static_cast<double>(on_ns) / static_cast<double>(exposure_ns);
+}
+
+std::optional<int64_t> Timeline::LedOnVideoNs() const { return synth::LedOnVideoNs(spec_); }
 
 double Timeline::TestSecondsFromVideoNs(int64_t t_video_ns) const {
   return SecondsFromNs(t_video_ns - led_on_video_ns_);

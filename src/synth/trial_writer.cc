@@ -63,29 +63,18 @@ std::vector<int64_t> FrameScheduleNs(const TrialSpec& spec) {
 
 void FillLedTruth(const TrialSpec& spec, const std::vector<int64_t>& frame_times_ns,
                   GroundTruth& truth) {
-  truth.led_on_video_ns.reset();
+  truth.led_on_video_ns = LedOnVideoNs(spec);
   truth.led_first_frame.reset();
   truth.led_first_frame_fraction = 0.0;
-  const int64_t duration_ns = NsFromSeconds(spec.duration_s);
-  const int64_t led_ns = NsFromSeconds(spec.led.on_video_s);
-  if (spec.led.on_video_s < 0.0 || led_ns >= duration_ns) return;
-  truth.led_on_video_ns = led_ns;
-
-  // the first exposure [t, t + exposure) that ends after the switch-on
-  const int64_t exposure_ns = std::max<int64_t>(1, NsFromSeconds(spec.camera.exposure_s));
+  if (!truth.led_on_video_ns) return;
+  // the first exposure that sees the LED on, by the fraction the renderer draws
   for (size_t i = 0; i < frame_times_ns.size(); ++i) {
-    const int64_t start_ns = frame_times_ns[i];
-    const int64_t end_ns = start_ns + exposure_ns;
-    if (end_ns <= led_ns) continue;
+    const double fraction = LedOnFractionOfExposure(spec, frame_times_ns[i]);
+    if (fraction <= 0.0) continue;
     truth.led_first_frame = static_cast<int64_t>(i);
-    truth.led_first_frame_fraction =
-        static_cast<double>(end_ns - std::max(led_ns, start_ns)) / static_cast<double>(exposure_ns);
+    truth.led_first_frame_fraction = fraction;
     return;
   }
-}
-
-CableGroup PulledGroupForFoot(Foot foot) {
-  return foot == Foot::kA || foot == Foot::kB ? CableGroup::kHR : CableGroup::kHL;
 }
 
 double BendSpoolTargetRad(const Calibration& calibration, CableGroup pulled_group) {
@@ -106,13 +95,7 @@ Status WriteTrialLog(const Timeline& timeline, const Calibration& calibration,
                      const std::filesystem::path& path) {
   const TrialSpec& spec = timeline.spec();
   const LogSpec& log = spec.log;
-  if (!log.led_event && log.led_on_device_ns != 0) {
-    return InvalidArgumentError(
-        "log.led_on_device_ns: expected 0 when log.led_event is false (the log's device clock "
-        "then starts at the LED switch-on), got " +
-        std::to_string(log.led_on_device_ns));
-  }
-  const CableGroup pulled = PulledGroupForFoot(spec.motion.foot);
+  const CableGroup pulled = PaperTableTwoMotion(spec.motion.foot).pulled_group;
   const double spool_target_rad = BendSpoolTargetRad(calibration, pulled);
 
   // header: what made the log and what it holds
@@ -201,12 +184,6 @@ Status WriteTrialLog(const Timeline& timeline, const Calibration& calibration,
 
 Result<WrittenTrial> WriteTrial(const TrialSpec& spec, const Calibration& calibration,
                                 const std::filesystem::path& output_dir) {
-  LIFTOFF_RETURN_IF_ERROR(spec.Validate());
-  if (!spec.log.led_event && spec.log.led_on_device_ns != 0) {
-    return InvalidArgumentError(
-        spec.id + ": log.led_on_device_ns: expected 0 when log.led_event is false, got " +
-        std::to_string(spec.log.led_on_device_ns));
-  }
   LIFTOFF_ASSIGN_OR_RETURN(const Timeline timeline, Timeline::Create(spec));
   std::error_code error;
   std::filesystem::create_directories(output_dir, error);
@@ -216,6 +193,9 @@ Result<WrittenTrial> WriteTrial(const TrialSpec& spec, const Calibration& calibr
   written.video_path = output_dir / (spec.id + std::string(VideoCodecExtension(spec.camera.codec)));
   written.log_path = output_dir / (spec.id + ".csv");
   written.truth_path = output_dir / (spec.id + ".truth.json");
+
+  // the renderer first: a trial that cannot be drawn leaves no file behind
+  LIFTOFF_ASSIGN_OR_RETURN(SceneRenderer renderer, SceneRenderer::Create(timeline));
 
   // the encoder, and the frame times as its container will store them (a slot that would
   // land on the previous frame's stored time is dropped, as a camera would)
@@ -235,7 +215,6 @@ Result<WrittenTrial> WriteTrial(const TrialSpec& spec, const Calibration& calibr
   }
 
   // render and encode frame by frame, each at the instant that will be stored
-  LIFTOFF_ASSIGN_OR_RETURN(SceneRenderer renderer, SceneRenderer::Create(timeline));
   int64_t render_ns = 0, encode_ns = 0;
   for (size_t i = 0; i < truth.frame_times_ns.size(); ++i) {
     const int64_t started_ns = MonotonicNowNs();
@@ -275,7 +254,7 @@ Result<WrittenTrial> WriteTrial(const TrialSpec& spec, const Calibration& calibr
   TrialRecord& entry = written.manifest_entry;
   entry.id = spec.id;
   entry.foot = spec.motion.foot;
-  entry.pulled_group = PulledGroupForFoot(spec.motion.foot);
+  entry.pulled_group = PaperTableTwoMotion(spec.motion.foot).pulled_group;
   entry.rotation = spec.motion.rotation;
   entry.log_path = written.log_path;
   entry.log_format = LogFormat::kLiftoff;

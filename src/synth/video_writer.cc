@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
-#include <sstream>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -20,6 +20,7 @@ extern "C" {
 }
 
 #include "liftoff/core/file.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::synth {
@@ -76,38 +77,35 @@ std::filesystem::path PartialPath(const std::filesystem::path& path) {
 }  // namespace
 
 Status VideoWriterOptions::Validate() const {
+  // "<field>: expected <range>[ <why>], got <value>" when out of range
+  const auto check = [](std::string_view field, double value, const NumberRange& range,
+                        std::string_view why = "") -> Status {
+    if (InNumberRange(value, range)) return Status::Ok();
+    return InvalidArgumentError(std::string(field) + ": expected " +
+                                DescribeNumberRange(range, true) + std::string(why) + ", got " +
+                                FormatNumber(value));
+  };
   const bool chroma_halved = codec != VideoCodec::kFfv1;
   for (const auto& [name, value] :
        {std::pair{"width_px", width_px}, std::pair{"height_px", height_px}}) {
-    if (value < 16 || value > 4096) {
-      return InvalidArgumentError(std::string(name) + ": expected 16 .. 4096 px, got " +
-                                  std::to_string(value));
-    }
+    LIFTOFF_RETURN_IF_ERROR(check(name, value, {.min = 16, .max = 4096}, " px"));
     if (chroma_halved && value % 2 != 0) {
       return InvalidArgumentError(std::string(name) + ": expected an even size for " +
                                   std::string(VideoCodecName(codec)) + " (4:2:0 chroma), got " +
                                   std::to_string(value));
     }
   }
-  if (!(nominal_fps >= 1.0 && nominal_fps <= 1000.0)) {
-    std::ostringstream got;
-    got << nominal_fps;
-    return InvalidArgumentError("nominal_fps: expected 1 .. 1000 Hz, got " + got.str());
+  if (constexpr NumberRange kFps{.min = 1, .max = 1000}; !InNumberRange(nominal_fps, kFps)) {
+    return InvalidArgumentError("nominal_fps: expected " + DescribeNumberRange(kFps) + " Hz, got " +
+                                FormatNumber(nominal_fps));
   }
-  if (codec == VideoCodec::kH264 && (quality < 0 || quality > 51)) {
-    return InvalidArgumentError("quality: expected a CRF of 0 .. 51 for h264, got " +
-                                std::to_string(quality));
+  if (codec == VideoCodec::kH264) {
+    LIFTOFF_RETURN_IF_ERROR(check("quality", quality, {.min = 0, .max = 51}, " (CRF for h264)"));
+  } else if (codec == VideoCodec::kMjpeg) {
+    LIFTOFF_RETURN_IF_ERROR(check("quality", quality, {.min = 2, .max = 31}, " (q:v for mjpeg)"));
   }
-  if (codec == VideoCodec::kMjpeg && (quality < 2 || quality > 31)) {
-    return InvalidArgumentError("quality: expected a q:v of 2 .. 31 for mjpeg, got " +
-                                std::to_string(quality));
-  }
-  if (time_base_den < 10'000 || time_base_den > 1'000'000'000) {
-    return InvalidArgumentError(
-        "time_base_den: expected 10000 .. 1000000000 ticks per second, got " +
-        std::to_string(time_base_den));
-  }
-  return Status::Ok();
+  return check("time_base_den", static_cast<double>(time_base_den),
+               {.min = 10'000, .max = 1'000'000'000}, " ticks per second");
 }
 
 struct VideoWriter::Impl {
@@ -176,9 +174,8 @@ struct VideoWriter::Impl {
 
 VideoWriter::VideoWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
-VideoWriter::~VideoWriter() {
-  if (impl_ != nullptr && !impl_->closed) (void)Close();
-}
+// Without Close() the file is unfinished: Impl's destructor deletes the .partial file.
+VideoWriter::~VideoWriter() = default;
 
 Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::filesystem::path& path,
                                                        const VideoWriterOptions& options) {
@@ -309,13 +306,14 @@ Status VideoWriter::Write(const cv::Mat& bgr, int64_t pts_ns) {
   Impl& impl = *impl_;
   assert(!impl.closed && "Write() after Close()");
   if (!impl.error.ok()) return impl.error;
-  const std::string frame_name = "frame " + std::to_string(impl.frames);
+  // the frame's name, built only for an error
+  const auto frame_name = [&impl] { return "frame " + std::to_string(impl.frames); };
 
   // checks the image and the timestamp
   if (bgr.type() != CV_8UC3 || bgr.cols != impl.options.width_px ||
       bgr.rows != impl.options.height_px) {
     return InvalidArgumentError(
-        impl.Where() + ": " + frame_name + ": expected an 8-bit BGR image of " +
+        impl.Where() + ": " + frame_name() + ": expected an 8-bit BGR image of " +
         std::to_string(impl.options.width_px) + "x" + std::to_string(impl.options.height_px) +
         " px, got " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) + " px with " +
         std::to_string(bgr.channels()) + " channel(s) of " + std::to_string(bgr.elemSize1() * 8) +
@@ -323,7 +321,7 @@ Status VideoWriter::Write(const cv::Mat& bgr, int64_t pts_ns) {
   }
   if (pts_ns < 0 || pts_ns <= impl.last_pts_ns) {
     return InvalidArgumentError(
-        impl.Where() + ": " + frame_name + ": timestamp " + FormatSeconds(pts_ns, 9) +
+        impl.Where() + ": " + frame_name() + ": timestamp " + FormatSeconds(pts_ns, 9) +
         " s: expected " +
         (impl.last_pts_ns < 0
              ? std::string(">= 0")
@@ -336,7 +334,7 @@ Status VideoWriter::Write(const cv::Mat& bgr, int64_t pts_ns) {
   }
   const int64_t tick = impl.TickFromNs(pts_ns);
   if (tick <= impl.last_tick) {
-    return InvalidArgumentError(impl.Where() + ": " + frame_name + ": timestamp " +
+    return InvalidArgumentError(impl.Where() + ": " + frame_name() + ": timestamp " +
                                 FormatSeconds(pts_ns, 9) + " s is stored at " +
                                 FormatSeconds(StoredPtsNs(pts_ns), 9) +
                                 " s, no later than the previous frame's (the container keeps " +
@@ -357,7 +355,7 @@ Status VideoWriter::Write(const cv::Mat& bgr, int64_t pts_ns) {
 
   // encodes and writes what is ready
   if (const int sent = avcodec_send_frame(impl.encoder, impl.frame); sent < 0) {
-    return impl.FailAv("encoding " + frame_name + " failed", sent);
+    return impl.FailAv("encoding " + frame_name() + " failed", sent);
   }
   LIFTOFF_RETURN_IF_ERROR(impl.DrainPackets());
   impl.last_pts_ns = pts_ns;

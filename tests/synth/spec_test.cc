@@ -135,6 +135,11 @@ TEST(TrialSpec, EachBadFieldNamesItsPath) {
        "motion.diagonal_lag_rad: expected a number in [-3.14159, 3.14159], got 4"},
       {[](TrialSpec& s) { s.log.led_on_device_ns = -1; },
        "log.led_on_device_ns: expected an integer in [0, 1e+15], got -1"},
+      {[](TrialSpec& s) {
+         s.log.led_event = false;
+         s.log.led_on_device_ns = 7;
+       },
+       "log.led_on_device_ns: expected 0 when log.led_event is false"},
       {[](TrialSpec& s) { s.log.clock_drift_ppm = 2000; },
        "log.clock_drift_ppm: expected a number in [-1000, 1000], got 2000"},
       {[](TrialSpec& s) { s.log.rate_hz = 0; },
@@ -193,7 +198,7 @@ TEST(TrialSpecJson, EmptyObjectGivesDefaults) {
 }
 
 TEST(TrialSpecJson, ReadsEveryKeyOfTheDocumentedShape) {
-  const json document = json::parse(R"({
+  json document = json::parse(R"({
     "id": "ci-007-mjpeg", "seed": 18446744073709551615, "duration_s": 3.5,
     "camera": {"width_px": 640, "height_px": 480, "fps": 120, "exposure_s": 0.005,
                "drop_probability": 0.1, "timestamp_jitter_s": 0.001, "codec": "mjpeg",
@@ -211,6 +216,19 @@ TEST(TrialSpecJson, ReadsEveryKeyOfTheDocumentedShape) {
             "jitter_s": 0.0005, "burst_period_s": 1, "burst_length_s": 0.1,
             "led_event": false, "lead_s": 2, "tail_s": 3}
   })");
+  // a log without an led_on event starts its device clock at the LED: a non-zero
+  // led_on_device_ns contradicts it
+  const Result<TrialSpec> contradictory = TrialSpecFromJson(document, "t.json", "/data/specs");
+  ASSERT_FALSE(contradictory.ok());
+  EXPECT_EQ(contradictory.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(contradictory.status().message(),
+              StartsWith("t.json: /log/led_on_device_ns: expected 0 when log.led_event is false"));
+  const Result<TrialSpec> without_event =
+      TrialSpecFromJson(json::parse(R"({"log": {"led_event": false}})"), "t.json", "");
+  ASSERT_TRUE(without_event.ok()) << without_event.status().ToString();
+  EXPECT_FALSE(without_event->log.led_event);
+
+  document["log"]["led_event"] = true;
   const Result<TrialSpec> read = TrialSpecFromJson(document, "t.json", "/data/specs");
   ASSERT_TRUE(read.ok()) << read.status().ToString();
   const TrialSpec& spec = *read;
@@ -258,7 +276,7 @@ TEST(TrialSpecJson, ReadsEveryKeyOfTheDocumentedShape) {
   EXPECT_EQ(spec.log.jitter_s, 0.0005);
   EXPECT_EQ(spec.log.burst_period_s, 1.0);
   EXPECT_EQ(spec.log.burst_length_s, 0.1);
-  EXPECT_FALSE(spec.log.led_event);
+  EXPECT_TRUE(spec.log.led_event);
   EXPECT_EQ(spec.log.lead_s, 2.0);
   EXPECT_EQ(spec.log.tail_s, 3.0);
 

@@ -377,19 +377,22 @@ TEST(VideoWriterOptions, OutOfRangeFieldsAreNamedWithTheirRange) {
     std::string message;
   };
   const Case cases[] = {
-      {[](auto& o) { o.width_px = 8; }, "width_px: expected 16 .. 4096 px, got 8"},
-      {[](auto& o) { o.height_px = 5000; }, "height_px: expected 16 .. 4096 px, got 5000"},
+      {[](auto& o) { o.width_px = 8; }, "width_px: expected an integer in [16, 4096] px, got 8"},
+      {[](auto& o) { o.height_px = 5000; },
+       "height_px: expected an integer in [16, 4096] px, got 5000"},
       {[](auto& o) { o.width_px = 161; },
        "width_px: expected an even size for h264 (4:2:0 chroma), got 161"},
-      {[](auto& o) { o.nominal_fps = 0.5; }, "nominal_fps: expected 1 .. 1000 Hz, got 0.5"},
-      {[](auto& o) { o.quality = 52; }, "quality: expected a CRF of 0 .. 51 for h264, got 52"},
+      {[](auto& o) { o.nominal_fps = 0.5; },
+       "nominal_fps: expected a number in [1, 1000] Hz, got 0.5"},
+      {[](auto& o) { o.quality = 52; },
+       "quality: expected an integer in [0, 51] (CRF for h264), got 52"},
       {[](auto& o) {
          o.codec = VideoCodec::kMjpeg;
          o.quality = 1;
        },
-       "quality: expected a q:v of 2 .. 31 for mjpeg, got 1"},
+       "quality: expected an integer in [2, 31] (q:v for mjpeg), got 1"},
       {[](auto& o) { o.time_base_den = 1000; },
-       "time_base_den: expected 10000 .. 1000000000 ticks per second, got 1000"},
+       "time_base_den: expected an integer in [10000, 1e+09] ticks per second, got 1000"},
   };
   for (const Case& c : cases) {
     VideoWriterOptions options = SmallClip(VideoCodec::kH264);
@@ -407,7 +410,8 @@ TEST(VideoWriter, OpenNamesTheFileForBadOptionsAndWrongExtension) {
   auto bad = VideoWriter::Open(scratch / "a.mkv", options);
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_THAT(bad.status().message(), HasSubstr("a.mkv: nominal_fps: expected 1 .. 1000 Hz"));
+  EXPECT_THAT(bad.status().message(),
+              HasSubstr("a.mkv: nominal_fps: expected a number in [1, 1000] Hz"));
 
   auto wrong = VideoWriter::Open(scratch / "a.mp4", SmallClip(VideoCodec::kFfv1));
   ASSERT_FALSE(wrong.ok());
@@ -509,11 +513,24 @@ TEST(VideoWriter, FileAppearsOnlyWhenClosed) {
     ASSERT_TRUE((*writer)->Write(PatternFrame(0), 0).ok());
     EXPECT_FALSE(std::filesystem::exists(path));
     EXPECT_TRUE(std::filesystem::exists(scratch / "clip.mp4.partial"));
-    // destroyed without Close(): closed then
+    ASSERT_TRUE((*writer)->Close().ok());
   }
   EXPECT_TRUE(std::filesystem::exists(path));
   EXPECT_FALSE(std::filesystem::exists(scratch / "clip.mp4.partial"));
   EXPECT_EQ(ReadBack(path).frames.size(), 1u);
+}
+
+TEST(VideoWriter, DroppedWithoutCloseLeavesNoVideo) {
+  ScratchDir scratch;
+  const auto path = ClipPath(scratch, VideoCodec::kH264);
+  {
+    auto writer = VideoWriter::Open(path, SmallClip(VideoCodec::kH264));
+    ASSERT_TRUE(writer.ok()) << writer.status().ToString();
+    ASSERT_TRUE((*writer)->Write(PatternFrame(0), 0).ok());
+    // destroyed without Close(), as on an error path: the half-written video is discarded
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_FALSE(std::filesystem::exists(scratch / "clip.mp4.partial"));
 }
 
 }  // namespace

@@ -97,7 +97,7 @@ class SceneRenderer {
   /// foot_rest_bottom_px() - height_mm * px_per_mm() (the truth tests compare against).
   double FootBottomPxAt(int64_t t_video_ns) const;
   /// Fraction of the exposure [t_video_ns, t_video_ns + exposure) during which the LED
-  /// is on, 0 .. 1.
+  /// is on, 0 .. 1 (Timeline::LedOnFractionOfExposure, as the truth counts it).
   double LedOnFraction(int64_t t_video_ns) const;
   /// Camera shake of frame `frame_index`: the picture's translation, px (x right,
   /// y down); 0 without shake.
@@ -144,7 +144,6 @@ class SceneRenderer {
   cv::Rect led_patch_;      // canvas px: the LED's light
   cv::Mat led_disc_alpha_;  // CV_32FC1 over led_patch_
   cv::Mat led_emission_;    // CV_32FC3 over led_patch_
-  std::optional<int64_t> led_on_ns_;
   int64_t exposure_ns_ = 1;
   RegionPx led_roi_px_, foot_roi_px_;
   std::vector<uint8_t> noise_positive_, noise_negative_;  // the noise table, split by sign

@@ -24,7 +24,7 @@ namespace liftoff::synth {
 
 /// The CI set's valid trials, in a fixed order with fixed seeds (docs/synth.md lists them).
 /// Every clip is short: mostly a 0.2 rad/s ramp starting 0.2 s after the LED at 0.61 s, the
-/// foot 1 mm up 1.5-4 s into the clip, which ends 0.4 s later; mostly 640x480. Ids are
+/// foot 1 mm up 1.46-3.84 s into the clip, which ends 0.4 s later; mostly 640x480. Ids are
 /// "ci-NN-what". The csv-curve trial names "ci-height-curve.csv" relative to the set's
 /// folder; WriteSet writes that file there and resolves the path.
 std::vector<TrialSpec> CiSet();

@@ -71,8 +71,8 @@ struct NuisanceSpec {
   /// Camera shake: random-walk translation, standard deviation of its step per frame,
   /// px (0 .. 2), bounded to +-4 px.
   double shake_px = 0.0;
-  /// Shadow under a lifted foot (a soft dark ellipse on the bed that shrinks and fades
-  /// as the foot rises).
+  /// Shadows under the feet: a soft dark ellipse on the bed under each foot, resting or
+  /// not, that shrinks and fades as the foot rises (false: no foot casts one).
   bool shadow = true;
 };
 
@@ -234,6 +234,15 @@ struct GroundTruth {
 /// pointer.
 Result<GroundTruth> GroundTruthFromJson(const nlohmann::json& document, const std::string& source);
 
+/// Exposure time per frame, ns (at least 1).
+int64_t ExposureNs(const CameraSpec& camera);
+/// The LED switch-on, video clock; nullopt when the LED never switches on within the clip
+/// (led.on_video_s outside [0, duration_s)).
+std::optional<int64_t> LedOnVideoNs(const TrialSpec& spec);
+/// Fraction of the exposure [t_frame_ns, t_frame_ns + exposure) during which the LED is
+/// on, 0 .. 1: what the renderer draws and what the truth reports for the first lit frame.
+double LedOnFractionOfExposure(const TrialSpec& spec, int64_t t_frame_ns);
+
 /// The trial's motion as functions of the clocks: what the renderer draws and the log
 /// generator samples. Pure and cheap; built once per trial.
 class Timeline {
@@ -270,6 +279,10 @@ class Timeline {
   double FootHeightMAt(Foot foot, int64_t t_video_ns) const;
   /// Whether the LED is on at a video instant (never, when LedOnVideoNs() is nullopt).
   bool LedOnAt(int64_t t_video_ns) const;
+  /// synth::LedOnFractionOfExposure of this trial.
+  double LedOnFractionOfExposure(int64_t t_frame_ns) const {
+    return synth::LedOnFractionOfExposure(spec_, t_frame_ns);
+  }
 
   /// First video instant at which the lifting foot's height exceeds `height_m`
   /// (nullopt when not within [0, duration]); exact to 1 ns: the result is the first

@@ -52,10 +52,6 @@ std::vector<int64_t> FrameScheduleNs(const TrialSpec& spec);
 void FillLedTruth(const TrialSpec& spec, const std::vector<int64_t>& frame_times_ns,
                   GroundTruth& truth);
 
-/// Horizontal cable group pulled to lift `foot`, by the paper's Table II read by foot
-/// letter, as the 2018 importer reads it: A and B pull HR, C and D pull HL.
-CableGroup PulledGroupForFoot(Foot foot);
-
 /// Spool angle the synthetic log's bend reaches, rad: the angle at which the cable on the
 /// largest groove is at 80 % of its length (the paper's P = 80 %), 0.2 * length / radius
 /// of that groove; positive for HR, negative for HL (as the emulator signs it).

@@ -56,7 +56,8 @@ struct VideoWriterOptions {
 
 /// One video file being written. Write frames in presentation order, then Close().
 /// Writing goes to `<path>.partial`, renamed onto `path` by Close(): a reader never sees
-/// half a video. Raises FFmpeg's global log level to warnings (x264 chatters at info).
+/// half a video, and a writer destroyed without Close() (an error path) leaves none. Raises
+/// FFmpeg's global log level to warnings (x264 chatters at info).
 class VideoWriter {
  public:
   /// Creates the file (and missing parent folders). kInvalidArgument for bad options or a
@@ -88,7 +89,8 @@ class VideoWriter {
   int64_t frames_written() const;
   const std::filesystem::path& path() const;
 
-  /// Closes the file when Close() was not called (errors are lost then).
+  /// Without Close(), discards the unfinished video (deletes `<path>.partial`): only an
+  /// explicit Close() publishes it.
   ~VideoWriter();
   VideoWriter(const VideoWriter&) = delete;
   VideoWriter& operator=(const VideoWriter&) = delete;
