@@ -3,7 +3,6 @@
 #include "liftoff/core/file.h"
 
 #include <algorithm>
-#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -15,6 +14,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::capture {
@@ -120,32 +120,21 @@ void AddIssue(LogReadReport& report, const LogReadOptions& options, int64_t line
   }
 }
 
-std::string Plural(int64_t count, std::string_view word) {
-  return std::to_string(count) + " " + std::string(word) + (count == 1 ? "" : "s");
-}
-
-// The 2018 log file of a foot's test: "Test3 Back Left Red.txt".
-std::string LogFileName(Foot foot, int test_number) {
-  static constexpr std::array<std::string_view, 4> kNames = {
-      "Front Right Blue", "Front Left Orange", "Back Right Purple", "Back Left Red"};
-  return "Test" + std::to_string(test_number) + " " +
-         std::string(kNames[static_cast<size_t>(foot)]) + ".txt";
-}
-
-// Paper Table II as printed, read by foot letter.
-struct TableTwoEntry {
-  CableGroup pulled_group;
-  RotationSense rotation;
-};
-
-TableTwoEntry TableTwo(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return {CableGroup::kHR, RotationSense::kPositive};
-    case Foot::kB: return {CableGroup::kHR, RotationSense::kNegative};
-    case Foot::kC: return {CableGroup::kHL, RotationSense::kPositive};
-    case Foot::kD: return {CableGroup::kHL, RotationSense::kNegative};
+// "back left" -> "Back Left": every word capitalised.
+std::string TitleCase(std::string_view text) {
+  std::string title(text);
+  for (size_t i = 0; i < title.size(); ++i) {
+    if (i == 0 || title[i - 1] == ' ')
+      title[i] = static_cast<char>(std::toupper(static_cast<unsigned char>(title[i])));
   }
-  return {CableGroup::kHR, RotationSense::kPositive};
+  return title;
+}
+
+// The 2018 log file of a foot's test, named by the foot's position and tape colour:
+// "Test3 Back Left Red.txt".
+std::string LogFileName(Foot foot, int test_number) {
+  return "Test" + std::to_string(test_number) + " " + TitleCase(FootPosition(foot)) + " " +
+         TitleCase(FootTapeColour(foot)) + ".txt";
 }
 
 // Digits printed after the decimal point ("5.67" -> 2, "10" -> 0).
@@ -235,9 +224,9 @@ Result<CsvRow> ParseCsvRow(std::string_view line_text, int64_t line, const std::
 
 Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration& calibration,
                                          const LogReadOptions& options) {
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(path));
   const std::string file = path.string();
+  if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(file);
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(path));
 
   ControllerLog log;
   log.header.calibration = calibration.name;
@@ -373,7 +362,7 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
     trial.foot = row.foot;
     trial.test_number = row.test_number;
     // group and rotation from Table II by foot letter
-    const TableTwoEntry entry = TableTwo(row.foot);
+    const FootLiftingMotion entry = PaperTableTwoMotion(row.foot);
     trial.pulled_group = entry.pulled_group;
     trial.rotation = entry.rotation;
     trial.notes = "pulled group " + std::string(CableGroupName(entry.pulled_group)) +

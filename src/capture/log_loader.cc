@@ -31,12 +31,7 @@ Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFo
   Result<ControllerLog> log = format == LogFormat::kLaika2018
                                   ? ImportLaika2018Log(path, calibration, options)
                                   : ReadControllerLog(path, options);
-  // every error names the file
-  if (!log.ok()) {
-    const Status& status = log.status();
-    if (status.message().find(path.filename().string()) != std::string::npos) return status;
-    return status.WithContext(path.string());
-  }
+  if (!log.ok()) return log.status();  // both readers name the file in every error
   if (format == LogFormat::kLiftoff) {
     for (LogSample& sample : log->samples) FillDerivedAngles(sample, calibration);
   }

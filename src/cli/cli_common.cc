@@ -1,6 +1,5 @@
 #include "cli_common.h"
 
-#include <fstream>
 #include <ostream>
 
 #include "liftoff/capture/log_loader.h"
@@ -35,6 +34,12 @@ Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
   return LoadCalibration(path);
 }
 
+Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange& range) {
+  if (InNumberRange(value_s, range)) return Status::Ok();
+  return InvalidArgumentError(std::string(flag) + ": expected " + DescribeNumberRange(range) +
+                              " s, got " + FormatNumber(value_s));
+}
+
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
   sync::LookupOptions options;
   const auto rule = sync::ParseLookupRule(choice.rule);
@@ -42,6 +47,10 @@ Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
     return InvalidArgumentError("--rule: expected linear or hold, got \"" + choice.rule + "\"");
   }
   options.rule = *rule;
+  LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag("--gap-threshold", choice.gap_threshold_s,
+                                           sync::LookupOptions::kGapThresholdRange));
+  LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag("--max-past-end", choice.max_past_end_s,
+                                           sync::LookupOptions::kMaxPastEndRange));
   options.gap_threshold_s = choice.gap_threshold_s;
   options.max_past_end_s = choice.max_past_end_s;
   LIFTOFF_RETURN_IF_ERROR(options.Validate());
@@ -52,13 +61,7 @@ Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std
                                     const Calibration& calibration, const LogReadOptions& options) {
   std::optional<LogFormat> parsed;
   if (format == "auto") {
-    // liftoff logs announce themselves on their first line; anything else is tried as 2018
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return NotFoundError(path.string() + ": no such file");
-    std::string first(16, '\0');
-    in.read(first.data(), static_cast<std::streamsize>(first.size()));
-    first.resize(static_cast<size_t>(in.gcount()));
-    parsed = first.rfind("# liftoff-log", 0) == 0 ? LogFormat::kLiftoff : LogFormat::kLaika2018;
+    LIFTOFF_ASSIGN_OR_RETURN(parsed, DetectLogFormat(path));
   } else {
     parsed = ParseLogFormat(format);
     if (!parsed) {

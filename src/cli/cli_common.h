@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <iosfwd>
 #include <string>
+#include <string_view>
 
 #include "liftoff/cli/commands.h"
 #include "liftoff/core/calibration.h"
 #include "liftoff/core/controller_log.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
 #include "liftoff/sync/lookup.h"
 
@@ -19,11 +21,15 @@ namespace liftoff::cli {
 Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
                                       const std::filesystem::path& manifest_choice = {});
 
+/// OK when `value_s` lies in `range`, else kInvalidArgument naming the flag:
+/// "--max-past-end: expected a number in [0, 1e+06] s, got 1e+10".
+Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange& range);
+
 /// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);
 
-/// Reads a log whose format is "auto", "liftoff" or "laika-2018"; "auto" looks at the
-/// first line (liftoff logs start with "# liftoff-log").
+/// Reads a log whose format is "auto", "liftoff" or "laika-2018"; "auto" asks
+/// DetectLogFormat (liftoff logs start with "# liftoff-log", after an optional BOM).
 Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std::string& format,
                                     const Calibration& calibration, const LogReadOptions& options);
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <ostream>
 #include <sstream>
 
@@ -12,6 +11,7 @@
 #include "liftoff/capture/laika2018.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
@@ -19,12 +19,6 @@
 
 namespace liftoff::cli {
 namespace {
-
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
 
 // Sends finished text to the output file, or to `out` when none is named.
 int Emit(const std::string& text, const std::filesystem::path& output_path, std::ostream& out,
@@ -123,7 +117,7 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   if (emitted != kExitOk) return emitted;
 
   if (!first_failure.ok()) {
-    err << "liftoff: " << analysis.failed << " of " << analysis.outcomes.size()
+    err << "liftoff: " << analysis.failed() << " of " << analysis.outcomes.size()
         << " trials failed; the table holds the others\n";
     return ExitCodeFor(first_failure.code());
   }
@@ -158,10 +152,13 @@ int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostr
 int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   auto lookup = LookupOptionsFrom(command.lookup);
   if (!lookup.ok()) return ReportError(lookup.status(), err);
-  if (!(command.uncertainty_s >= 0.0)) {
-    return ReportError(InvalidArgumentError("--uncertainty: expected seconds >= 0, got " +
-                                            Fixed(command.uncertainty_s, 6)),
-                       err);
+  // video times and their uncertainty, bounded so they convert to nanoseconds
+  constexpr NumberRange kTimeRange{.min = 0.0, .max = kMaxTimeSeconds};
+  for (const auto& [flag, value_s] :
+       {std::pair{"--led-on", command.led_on_s}, std::pair{"--liftoff", command.liftoff_s},
+        std::pair{"--uncertainty", command.uncertainty_s}}) {
+    const Status checked = CheckSecondsFlag(flag, value_s, kTimeRange);
+    if (!checked.ok()) return ReportError(checked, err);
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
@@ -207,9 +204,9 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
       << "interval LED on -> liftoff: " << FormatSeconds(measured->interval_ns, 3) << " s +- "
       << FormatSeconds(measured->interval_uncertainty_ns, 3) << " s\n"
       << "log instant: " << FormatSeconds(measured->liftoff_log_ns, 3) << " s\n"
-      << "vertebra angle: " << Fixed(at.vertebra_rad, 4) << " rad; at liftoff |angle| "
-      << Fixed(measured->liftoff_rad, 4) << " rad in [" << Fixed(measured->lower_rad, 4) << ", "
-      << Fixed(measured->upper_rad, 4) << "]\n";
+      << "vertebra angle: " << FormatFixed(at.vertebra_rad, 4) << " rad; at liftoff |angle| "
+      << FormatFixed(measured->liftoff_rad, 4) << " rad in [" << FormatFixed(measured->lower_rad, 4)
+      << ", " << FormatFixed(measured->upper_rad, 4) << "]\n";
   for (const std::string& warning : at.warnings) out << "note: " << warning << '\n';
   return kExitOk;
 }
@@ -218,9 +215,9 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
 // liftoff log
 
 int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
-  if (!(command.gap_threshold_s > 0.0)) {
-    return ReportError(InvalidArgumentError("--gap-threshold: expected seconds > 0"), err);
-  }
+  const Status gap_checked = CheckSecondsFlag("--gap-threshold", command.gap_threshold_s,
+                                              sync::LookupOptions::kGapThresholdRange);
+  if (!gap_checked.ok()) return ReportError(gap_checked, err);
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   LogReadOptions read_options;
@@ -282,8 +279,9 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
         << ", bad lines: " << log->report.bad_lines
         << (log->report.truncated_last_line ? " (last line truncated)" : "") << '\n'
         << "  device time: " << FormatSeconds(log->FirstSampleNs()) << " .. "
-        << FormatSeconds(log->LastSampleNs()) << " s, mean rate " << Fixed(rate_hz, 1) << " Hz\n"
-        << "  gaps longer than " << Fixed(command.gap_threshold_s, 3) << " s: " << gaps;
+        << FormatSeconds(log->LastSampleNs()) << " s, mean rate " << FormatFixed(rate_hz, 1)
+        << " Hz\n"
+        << "  gaps longer than " << FormatFixed(command.gap_threshold_s, 3) << " s: " << gaps;
     if (longest_gap_ns > 0) {
       out << " (longest " << FormatSeconds(longest_gap_ns) << " s after "
           << FormatSeconds(longest_gap_at_ns) << " s)";
@@ -292,8 +290,8 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
         << "  LED on: "
         << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)") << '\n';
     if (std::isfinite(min_angle)) {
-      out << "  vertebra angle: " << Fixed(min_angle, 4) << " .. " << Fixed(max_angle, 4)
-          << " rad (calibration " << calibration->Brief() << ")\n";
+      out << "  vertebra angle: " << FormatFixed(min_angle, 4) << " .. "
+          << FormatFixed(max_angle, 4) << " rad (calibration " << calibration->Brief() << ")\n";
     }
   }
 
@@ -319,30 +317,30 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err) 
   const double counts_per_shaft_rev = c.encoder_counts_per_motor_rev * c.gearbox_ratio;
   out << "calibration: " << c.Brief() << '\n';
   if (!c.description.empty()) out << "  " << c.description << '\n';
-  out << "rotating vertebra: " << Fixed(c.encoder_counts_per_motor_rev, 0) << " counts/motor rev x "
-      << Fixed(c.gearbox_ratio, 0) << ":1 gearbox x " << Fixed(c.spur_gear_ratio, 2)
-      << ":1 spur gear\n"
-      << "  " << Fixed(counts_per_shaft_rev, 0) << " counts per output-shaft revolution, "
-      << Fixed(counts_per_shaft_rev * c.spur_gear_ratio, 0) << " per vertebra revolution\n"
-      << "  one count = " << Fixed(c.VertebraAngleFromCounts(1) * 1e6, 1)
+  out << "rotating vertebra: " << FormatFixed(c.encoder_counts_per_motor_rev, 0)
+      << " counts/motor rev x " << FormatFixed(c.gearbox_ratio, 0) << ":1 gearbox x "
+      << FormatFixed(c.spur_gear_ratio, 2) << ":1 spur gear\n"
+      << "  " << FormatFixed(counts_per_shaft_rev, 0) << " counts per output-shaft revolution, "
+      << FormatFixed(counts_per_shaft_rev * c.spur_gear_ratio, 0) << " per vertebra revolution\n"
+      << "  one count = " << FormatFixed(c.VertebraAngleFromCounts(1) * 1e6, 1)
       << " microrad of vertebra rotation\n"
       << "bending spool grooves (m):";
-  for (double radius : c.spool_groove_radii_m) out << ' ' << Fixed(radius, 4);
+  for (double radius : c.spool_groove_radii_m) out << ' ' << FormatFixed(radius, 4);
   out << "; cable lengths (m):";
-  for (double length : c.cable_lengths_m) out << ' ' << Fixed(length, 4);
+  for (double length : c.cable_lengths_m) out << ' ' << FormatFixed(length, 4);
   const auto percent = c.PercentLengthChangeFromSpoolAngle(1.0);
   out << "\n  percent length change per spool radian:";
-  for (double p : percent) out << ' ' << Fixed(p, 2);
+  for (double p : percent) out << ' ' << FormatFixed(p, 2);
   out << "\nmaterials (N/m):";
   for (const MaterialConstant& m : c.materials) {
-    out << ' ' << m.name << ' ' << Fixed(m.stiffness_n_per_m, 0) << " +- "
-        << Fixed(m.stiffness_stddev_n_per_m, 0) << ';';
+    out << ' ' << m.name << ' ' << FormatFixed(m.stiffness_n_per_m, 0) << " +- "
+        << FormatFixed(m.stiffness_stddev_n_per_m, 0) << ';';
   }
   out << "\ntension points (silicone / Buna-N / spring, N/m):\n";
   for (const TensionPoint& p : c.tension_points) {
-    out << "  " << p.name << " (" << (p.sigma >= 0 ? "+" : "") << Fixed(p.sigma, 0)
-        << " sigma): " << Fixed(p.silicone_n_per_m, 0) << " / " << Fixed(p.buna_n_n_per_m, 0)
-        << " / " << Fixed(p.spring_n_per_m, 0) << '\n';
+    out << "  " << p.name << " (" << (p.sigma >= 0 ? "+" : "") << FormatFixed(p.sigma, 0)
+        << " sigma): " << FormatFixed(p.silicone_n_per_m, 0) << " / "
+        << FormatFixed(p.buna_n_n_per_m, 0) << " / " << FormatFixed(p.spring_n_per_m, 0) << '\n';
   }
   if (!c.notes.empty()) {
     out << "provenance:\n";

@@ -1,6 +1,7 @@
 #include "liftoff/core/controller_log.h"
 
 #include "liftoff/core/file.h"
+#include "liftoff/core/text.h"
 
 #include <algorithm>
 #include <array>
@@ -15,6 +16,8 @@ namespace {
 
 constexpr int kFormatVersion = 1;
 constexpr std::string_view kMagic = "# liftoff-log";
+// a byte-order mark an editor may put in front of the first line
+constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
 constexpr std::string_view kColumnHeader =
     "device_time_ns,host_time_ns,seq,led,bend_counts,rotate_counts,bend_spool_rad,"
     "rotate_shaft_rad,vertebra_rad,event,detail";
@@ -359,8 +362,11 @@ std::string HeaderText(const LogHeader& header) {
   return text + std::string(kColumnHeader) + "\n";
 }
 
-std::string Plural(int64_t count, std::string_view noun) {
-  return std::to_string(count) + " " + std::string(noun) + (count == 1 ? "" : "s");
+// Refuses an event detail the format cannot hold (one line per row).
+Status CheckEventDetail(const std::filesystem::path& path, const LogEvent& event) {
+  if (!HasLineBreak(event.detail)) return Status::Ok();
+  return InvalidArgumentError(path.string() + ": event detail: expected one line, got " +
+                              Quote(event.detail));
 }
 
 }  // namespace
@@ -434,8 +440,8 @@ Status LogReadOptions::Validate() const {
 
 Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
                                         const LogReadOptions& options) {
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
   const std::string name = path.string();
+  if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(name);
   std::error_code error;
   if (!std::filesystem::exists(path, error)) return NotFoundError(name + ": no such file");
   if (std::filesystem::is_directory(path, error)) {
@@ -455,7 +461,7 @@ Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
 
   // the version line (a file cut off before it is an empty log)
   if (!lines.Next(line, has_line_end)) return empty_log();
-  if (line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);  // a byte-order mark from an editor
+  if (line.starts_with(kUtf8ByteOrderMark)) line.erase(0, kUtf8ByteOrderMark.size());
   if (!has_line_end && std::string_view(kMagic).starts_with(line)) return empty_log();
   const std::string_view first = line;
   const std::string_view version_text =
@@ -594,10 +600,7 @@ Status ControllerLogWriter::Append(const LogSample& sample) {
 Status ControllerLogWriter::Append(const LogEvent& event) {
   assert(is_open() && "Append on a writer that is not open");
   if (!is_open()) return IoError(path_.string() + ": log writer is not open");
-  if (HasLineBreak(event.detail)) {
-    return InvalidArgumentError(path_.string() + ": event detail: expected one line, got " +
-                                Quote(event.detail));
-  }
+  LIFTOFF_RETURN_IF_ERROR(CheckEventDetail(path_, event));
   out_ << FormatEvent(event);
   if (!out_) return IoError(path_.string() + ": write failed");
   return Status::Ok();
@@ -620,38 +623,42 @@ Status ControllerLogWriter::Close() {
 }
 
 Status WriteControllerLog(const std::filesystem::path& path, const ControllerLog& log) {
-  // what a writer would refuse, named by the real file
+  // what a writer would refuse
   LIFTOFF_RETURN_IF_ERROR(CheckHeader(path, log.header));
-  for (const LogEvent& event : log.events) {
-    if (HasLineBreak(event.detail)) {
-      return InvalidArgumentError(path.string() + ": event detail: expected one line, got " +
-                                  Quote(event.detail));
-    }
-  }
+  for (const LogEvent& event : log.events) LIFTOFF_RETURN_IF_ERROR(CheckEventDetail(path, event));
 
-  // write beside the target, then rename: readers never see half a file
-  LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(path));
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
-  ControllerLogWriter writer;
-  Status status = writer.Open(temporary, log.header);
   // samples and events merged in device time; an event goes before a sample at its instant
+  std::string text = HeaderText(log.header);
   auto sample = log.samples.begin();
   auto event = log.events.begin();
-  while (status.ok() && (sample != log.samples.end() || event != log.events.end())) {
+  while (sample != log.samples.end() || event != log.events.end()) {
     if (event != log.events.end() &&
         (sample == log.samples.end() || event->device_time_ns <= sample->device_time_ns)) {
-      status = writer.Append(*event++);
+      text += FormatEvent(*event++);
     } else {
-      status = writer.Append(*sample++);
+      text += FormatSample(*sample++);
     }
   }
-  if (status.ok()) status = writer.Close();
-  if (status.ok()) return RenameIntoPlace(temporary, path);
-  (void)writer.Close();
-  std::error_code ignored;
-  std::filesystem::remove(temporary, ignored);
-  return status;
+  return WriteFileAtomically(path, text);
+}
+
+Result<LogFormat> DetectLogFormat(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return NotFoundError(name + ": no such file");
+  if (std::filesystem::is_directory(path, error)) {
+    return InvalidArgumentError(name + ": is a directory, expected a controller log");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return IoError(name + ": cannot open for reading");
+  // enough bytes for a byte-order mark and the magic
+  std::string first(kUtf8ByteOrderMark.size() + kMagic.size(), '\0');
+  in.read(first.data(), static_cast<std::streamsize>(first.size()));
+  if (in.bad()) return IoError(name + ": read failed");
+  first.resize(static_cast<size_t>(in.gcount()));
+  std::string_view start = first;
+  if (start.starts_with(kUtf8ByteOrderMark)) start.remove_prefix(kUtf8ByteOrderMark.size());
+  return start.starts_with(kMagic) ? LogFormat::kLiftoff : LogFormat::kLaika2018;
 }
 
 }  // namespace liftoff

@@ -10,7 +10,15 @@ namespace {
 __extension__ using Int128 = __int128;  // exact decimal arithmetic
 }  // namespace
 
-int64_t NsFromSeconds(double seconds) { return std::llround(seconds * 1e9); }
+int64_t NsFromSeconds(double seconds) {
+  // llround is undefined outside int64: saturate there (2^63 ns is about 9.2e9 s)
+  constexpr double kTwoToThe63 = 9223372036854775808.0;
+  const double ns = seconds * 1e9;
+  if (std::isnan(ns)) return 0;
+  if (ns >= kTwoToThe63) return std::numeric_limits<int64_t>::max();
+  if (ns <= -kTwoToThe63) return std::numeric_limits<int64_t>::min();
+  return std::llround(ns);
+}
 
 Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns) {
   assert(unit_ns > 0);

@@ -1,7 +1,6 @@
 #include "liftoff/stats/sim_results.h"
 
 #include <algorithm>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -18,12 +17,6 @@ constexpr int64_t kFormatVersion = 1;
 const std::vector<std::string_view> kFootNames = {"A", "B", "C", "D"};
 const std::vector<std::string_view> kGroupNames = {"HT", "HB", "HR", "HL"};
 const std::vector<std::string_view> kRotationNames = {"+", "-"};
-
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 SimRun ReadRun(JsonReader& reader) {
   SimRun run;

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <tuple>
+
+#include "liftoff/core/json.h"
 
 namespace liftoff::sync {
 namespace {
@@ -75,13 +78,13 @@ std::optional<LookupRule> ParseLookupRule(std::string_view text) {
 }
 
 Status LookupOptions::Validate() const {
-  if (!std::isfinite(gap_threshold_s) || gap_threshold_s <= 0.0) {
-    return InvalidArgumentError("lookup options: gap_threshold_s: expected a number > 0 s, got " +
-                                std::to_string(gap_threshold_s));
-  }
-  if (!std::isfinite(max_past_end_s) || max_past_end_s < 0.0) {
-    return InvalidArgumentError("lookup options: max_past_end_s: expected a number >= 0 s, got " +
-                                std::to_string(max_past_end_s));
+  for (const auto& [name, value_s, range] :
+       {std::tuple{"gap_threshold_s", gap_threshold_s, kGapThresholdRange},
+        std::tuple{"max_past_end_s", max_past_end_s, kMaxPastEndRange}}) {
+    if (!InNumberRange(value_s, range)) {
+      return InvalidArgumentError(std::string("lookup options: ") + name + ": expected " +
+                                  DescribeNumberRange(range) + " s, got " + FormatNumber(value_s));
+    }
   }
   return Status::Ok();
 }
@@ -157,12 +160,10 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   // range of the rule's answer over the window: its ends and every sample inside
   const int64_t window_begin_ns = query_ns - query_uncertainty_ns;
   const int64_t window_end_ns = query_ns + query_uncertainty_ns;
-  double lower = std::min(AngleAt(points, window_begin_ns, options.rule),
-                          AngleAt(points, window_end_ns, options.rule));
-  double upper = std::max(AngleAt(points, window_begin_ns, options.rule),
-                          AngleAt(points, window_end_ns, options.rule));
-  lower = std::min(lower, lookup.vertebra_rad);
-  upper = std::max(upper, lookup.vertebra_rad);
+  const double at_window_begin_rad = AngleAt(points, window_begin_ns, options.rule);
+  const double at_window_end_rad = AngleAt(points, window_end_ns, options.rule);
+  double lower = std::min({at_window_begin_rad, at_window_end_rad, lookup.vertebra_rad});
+  double upper = std::max({at_window_begin_rad, at_window_end_rad, lookup.vertebra_rad});
   const auto inside_begin =
       std::upper_bound(points.begin(), points.end(), window_begin_ns,
                        [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });

@@ -1,17 +1,15 @@
 #include "liftoff/sync/trial_analysis.h"
 
+#include <algorithm>
+
 #include "liftoff/capture/log_loader.h"
 
 namespace liftoff::sync {
 namespace {
 
-// the error with the trial id and, unless it already names it, the file in front
-Status ForTrial(const Status& status, const TrialRecord& trial, const std::filesystem::path& file) {
-  Status located = status;
-  if (!file.empty() && status.message().find(file.filename().string()) == std::string::npos) {
-    located = status.WithContext(file.string());
-  }
-  return located.WithContext(trial.id);
+// the error with the trial id in front
+Status ForTrial(const Status& status, const TrialRecord& trial) {
+  return status.WithContext(trial.id);
 }
 
 // one trial, start to end
@@ -21,24 +19,28 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
   // hand times are the only source of event times for now
   if (!trial.times) {
     if (trial.video_path) {
-      return ForTrial(
-          UnsupportedError("automatic video analysis is not available yet; give hand times"), trial,
-          *trial.video_path);
+      return ForTrial(UnsupportedError(trial.video_path->string() +
+                                       ": automatic video analysis is not available yet; "
+                                       "give hand times"),
+                      trial);
     }
-    const std::filesystem::path manifest_name =
-        manifest.source_path.empty() ? std::filesystem::path("manifest") : manifest.source_path;
+    const std::string manifest_name =
+        manifest.source_path.empty() ? "manifest" : manifest.source_path.string();
     return ForTrial(
-        InvalidArgumentError("the trial has neither event times nor a video; give hand times"),
-        trial, manifest_name);
+        InvalidArgumentError(manifest_name + ": the trial has neither event times nor a video; "
+                                             "give hand times"),
+        trial);
   }
 
-  // the log, then the angle at liftoff on it
+  // the log (its errors name it), then the angle at liftoff on it (they do not)
   Result<ControllerLog> log =
       capture::LoadControllerLog(trial.log_path, trial.log_format, calibration, options.log);
-  if (!log.ok()) return ForTrial(log.status(), trial, trial.log_path);
+  if (!log.ok()) return ForTrial(log.status(), trial);
   outcome.log_report = log->report;
   Result<LiftoffMeasurement> measurement = MeasureLiftoff(*log, *trial.times, options.lookup);
-  if (!measurement.ok()) return ForTrial(measurement.status(), trial, trial.log_path);
+  if (!measurement.ok()) {
+    return ForTrial(measurement.status().WithContext(trial.log_path.string()), trial);
+  }
   outcome.measurement = std::move(measurement).value();
   return Status::Ok();
 }
@@ -48,6 +50,11 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
 Status AnalysisOptions::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(lookup.Validate());
   return log.Validate();
+}
+
+int64_t ManifestAnalysis::failed() const {
+  return std::count_if(outcomes.begin(), outcomes.end(),
+                       [](const TrialOutcome& outcome) { return !outcome.status.ok(); });
 }
 
 std::vector<stats::TrialValue> ManifestAnalysis::Values() const {
@@ -92,7 +99,6 @@ ManifestAnalysis AnalyzeManifest(const TrialManifest& manifest, const Calibratio
     // bad options fail every trial alike; otherwise each trial stands alone
     outcome.status = options_status.ok() ? AnalyzeTrial(manifest, calibration, options, outcome)
                                          : options_status.WithContext(trial.id);
-    if (!outcome.status.ok()) ++analysis.failed;
     analysis.outcomes.push_back(std::move(outcome));
   }
   return analysis;

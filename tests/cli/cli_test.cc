@@ -305,6 +305,60 @@ TEST(CliSync, OneLookupHoldVersusLinear) {
   EXPECT_NEAR(hold["liftoff_rad"].get<double>(), 2.2 / 4, 1e-9);  // sample at 2.2 s
 }
 
+TEST(CliSync, SecondsBeyondTheLimitAreRejectedNamingTheFlag) {
+  // 1e10 s once overflowed to INT64_MIN ns: the lookup answered far past the log's end
+  ScratchDir scratch;
+  WriteFile(scratch / "ramp.txt", RampLog2018(5000));
+  const auto run = [](const SyncCommand& command) {
+    std::ostringstream out, err;
+    CommandRun result;
+    result.code = RunSync(command, out, err);
+    result.err = err.str();
+    return result;
+  };
+  SyncCommand command;
+  command.log_path = scratch / "ramp.txt";
+  command.led_on_s = 1.0;
+  command.liftoff_s = 3.25;
+  command.lookup.max_past_end_s = 1e10;
+  CommandRun result = run(command);
+  EXPECT_EQ(result.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(result.err,
+              HasSubstr("--max-past-end: expected a number in [0, 1e+06] s, got 1e+10"));
+  command.lookup.max_past_end_s = 1.0;
+  command.liftoff_s = 1e10;
+  result = run(command);
+  EXPECT_EQ(result.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(result.err, HasSubstr("--liftoff: expected a number in [0, 1e+06] s, got 1e+10"));
+  // and through the binary's own flag parsing
+  const CommandRun binary = RunBinary(
+      "sync " + Quoted(scratch / "ramp.txt") + " --led-on 1 --liftoff 3.25 --max-past-end 1e10",
+      scratch);
+  EXPECT_EQ(binary.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(binary.err, HasSubstr("--max-past-end"));
+  LogCommand log;
+  log.log_path = scratch / "ramp.txt";
+  log.gap_threshold_s = 1e10;
+  std::ostringstream out, err;
+  EXPECT_EQ(RunLog(log, out, err), ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(err.str(), HasSubstr("--gap-threshold"));
+}
+
+TEST(CliLog, AutoFormatRecognisesALiftoffLogBehindAByteOrderMark) {
+  ScratchDir scratch;
+  WriteFile(scratch / "bom.csv",
+            "\xEF\xBB\xBF# liftoff-log 1\n"
+            "device_time_ns,host_time_ns,seq,led,bend_counts,rotate_counts,bend_spool_rad,"
+            "rotate_shaft_rad,vertebra_rad,event,detail\n"
+            "0,,,,,,,,0.5,,\n100000000,,,,,,,,0.6,,\n");
+  LogCommand command;
+  command.log_path = scratch / "bom.csv";  // log_format "auto"
+  std::ostringstream out, err;
+  ASSERT_EQ(RunLog(command, out, err), kExitOk) << err.str();
+  EXPECT_THAT(out.str(), HasSubstr("(liftoff)"));
+  EXPECT_THAT(out.str(), HasSubstr("samples: 2"));
+}
+
 TEST(Samples, RegenerateByteForByte) {
   ScratchDir scratch;
   const std::string command =

@@ -608,8 +608,26 @@ TEST(ControllerLog, ReadOptionsRejectNegativeLimits) {
   options.max_issues_kept = -2;
   EXPECT_THAT(options.Validate().message(), HasSubstr("max_issues_kept"));
   ScratchDir dir;
-  EXPECT_EQ(ReadControllerLog(dir / "x.csv", options).status().code(),
-            StatusCode::kInvalidArgument);
+  const Status read = ReadControllerLog(dir / "x.csv", options).status();
+  EXPECT_EQ(read.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(read.message(), StartsWith((dir / "x.csv").string() + ": "));  // names the file
+}
+
+TEST(ControllerLog, DetectsItsFormatPastAByteOrderMark) {
+  ScratchDir dir;
+  const std::string body = "# liftoff-log 1\n" + std::string(kColumns) + "\n7,,,,,,,,,,\n";
+  WriteFile(dir / "plain.csv", body);
+  WriteFile(dir / "bom.csv", "\xEF\xBB\xBF" + body);  // as ReadControllerLog accepts
+  WriteFile(dir / "2018.txt", "0,0.01,\r100,0.02,\r");
+  WriteFile(dir / "short.txt", "# lift");
+  EXPECT_EQ(DetectLogFormat(dir / "plain.csv").value(), LogFormat::kLiftoff);
+  EXPECT_EQ(DetectLogFormat(dir / "bom.csv").value(), LogFormat::kLiftoff);
+  EXPECT_EQ(DetectLogFormat(dir / "2018.txt").value(), LogFormat::kLaika2018);
+  EXPECT_EQ(DetectLogFormat(dir / "short.txt").value(), LogFormat::kLaika2018);
+  const Status missing = DetectLogFormat(dir / "none.csv").status();
+  EXPECT_EQ(missing.code(), StatusCode::kNotFound);
+  EXPECT_THAT(missing.message(), HasSubstr("none.csv"));
+  EXPECT_EQ(DetectLogFormat(dir.path()).status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST(ControllerLog, BriefOfACleanReadCountsSamples) {

@@ -121,10 +121,12 @@ TEST(Manifest, EachMalformedFieldNamesItsJsonPointer) {
       {"/trials/0/foot", "E", "trials.json: /trials/0/foot: expected one of A, B, C, D, got \"E\""},
       {"/trials/0/id", 7, "trials.json: /trials/0/id: expected a string, got 7"},
       {"/trials/0/id", "", "trials.json: /trials/0/id: expected a non-empty id"},
-      {"/trials/0/test", 0, "trials.json: /trials/0/test: expected an integer >= 1, got 0"},
-      {"/trials/0/test", 1.5, "trials.json: /trials/0/test: expected an integer >= 1, got 1.5"},
+      {"/trials/0/test", 0,
+       "trials.json: /trials/0/test: expected an integer in [1, 1e+09], got 0"},
+      {"/trials/0/test", 1.5,
+       "trials.json: /trials/0/test: expected an integer in [1, 1e+09], got 1.5"},
       {"/trials/0/test", 3'000'000'000,
-       "trials.json: /trials/0/test: expected a test number below 2^31"},
+       "trials.json: /trials/0/test: expected an integer in [1, 1e+09], got 3e+09"},
       {"/trials/0/pulled_group", "HX",
        "trials.json: /trials/0/pulled_group: expected one of HR, HL, HT, HB, got \"HX\""},
       {"/trials/0/rotation", "cw",
@@ -137,11 +139,18 @@ TEST(Manifest, EachMalformedFieldNamesItsJsonPointer) {
       {"/trials/0/video", nlohmann::json::object(),
        "trials.json: /trials/0/video/path: missing required field"},
       {"/trials/0/times/led_on_s", "1.0",
-       "trials.json: /trials/0/times/led_on_s: expected a number >= 0, got \"1.0\""},
+       "trials.json: /trials/0/times/led_on_s: expected a number in [0, 1e+06], got \"1.0\""},
       {"/trials/0/times/liftoff_s", 0.5,
        "trials.json: /trials/0/times/liftoff_s: expected a time after led_on_s (1 s), got 0.5"},
       {"/trials/0/times/led_on_uncertainty_s", -0.1,
-       "trials.json: /trials/0/times/led_on_uncertainty_s: expected a number >= 0, got -0.1"},
+       "trials.json: /trials/0/times/led_on_uncertainty_s: expected a number in [0, 1e+06], got "
+       "-0.1"},
+      // beyond kMaxTimeSeconds: once converted to INT64_MIN nanoseconds without a word
+      {"/trials/0/times/liftoff_s", 1e10,
+       "trials.json: /trials/0/times/liftoff_s: expected a number in [0, 1e+06], got 1e+10"},
+      {"/trials/0/times/liftoff_uncertainty_s", 1e10,
+       "trials.json: /trials/0/times/liftoff_uncertainty_s: expected a number in [0, 1e+06], got "
+       "1e+10"},
       {"/trials/0/roi/led_px", nlohmann::json::array({1, 2, 3}),
        "trials.json: /trials/0/roi/led_px: expected [x, y, width, height] in whole pixels"},
       {"/trials/0/roi/led_px", nlohmann::json::array({1, 2, 0, 4}),
@@ -205,7 +214,7 @@ TEST(Manifest, DuplicateIdsNameBothTrials) {
   const Result<TrialManifest> manifest = ManifestFromJson(document, "trials.json", "/data");
   ASSERT_FALSE(manifest.ok());
   EXPECT_EQ(manifest.status().message(),
-            "trials.json: /trials/2/id: duplicate id \"A1\", also used by /trials/0");
+            "trials.json: trials[0] and trials[2] have the same id \"A1\"");
 }
 
 TEST(Manifest, UnknownKeysAreRejectedWhereverTheyAre) {

@@ -99,6 +99,16 @@ TEST(TimeConversions, NsFromSecondsRoundsToNearest) {
   EXPECT_EQ(NsFromMicroseconds(-3), -3'000);
 }
 
+TEST(TimeConversions, NsFromSecondsSaturatesInsteadOfOverflowing) {
+  constexpr int64_t kMax = std::numeric_limits<int64_t>::max();
+  constexpr int64_t kMin = std::numeric_limits<int64_t>::min();
+  EXPECT_EQ(NsFromSeconds(1e10), kMax);  // once INT64_MIN through llround's overflow
+  EXPECT_EQ(NsFromSeconds(-1e10), kMin);
+  EXPECT_EQ(NsFromSeconds(std::numeric_limits<double>::infinity()), kMax);
+  EXPECT_EQ(NsFromSeconds(std::numeric_limits<double>::quiet_NaN()), 0);
+  EXPECT_EQ(NsFromSeconds(kMaxTimeSeconds), 1'000'000 * kSecond);
+}
+
 TEST(FormatSeconds, PrintsRequestedDecimals) {
   EXPECT_EQ(FormatSeconds(1'500'000'000), "1.500");
   EXPECT_EQ(FormatSeconds(-250'000'000, 2), "-0.25");

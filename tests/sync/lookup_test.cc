@@ -74,6 +74,23 @@ TEST(LookupOptions, RejectsNonPositiveGapThresholdAndNegativeTolerance) {
             StatusCode::kInvalidArgument);
 }
 
+TEST(LookupOptions, RejectsSecondsBeyondKMaxTimeSeconds) {
+  // 1e10 s once became INT64_MIN ns and answered every query far past the log's end
+  LookupOptions options;
+  options.max_past_end_s = 1e10;
+  EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(options.Validate().message(),
+            "lookup options: max_past_end_s: expected a number in [0, 1e+06] s, got 1e+10");
+  EXPECT_EQ(LookupVertebraAngle(Ramp(), Ms(500), 0, options).status().code(),
+            StatusCode::kInvalidArgument);
+  options = {};
+  options.gap_threshold_s = 1e10;
+  EXPECT_EQ(options.Validate().message(),
+            "lookup options: gap_threshold_s: expected a number in (0, 1e+06] s, got 1e+10");
+  options.gap_threshold_s = kMaxTimeSeconds;
+  EXPECT_TRUE(options.Validate().ok());
+}
+
 TEST(LookupVertebraAngle, LinearInterpolatesAndHoldTakesTheSampleBefore) {
   // 0.25 s lies halfway between 0.2 s (0.10 rad) and 0.3 s (0.15 rad)
   auto linear = LookupVertebraAngle(Ramp(), Ms(250), 0, Rule(LookupRule::kLinear));

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "liftoff/core/manifest.h"
 #include "liftoff/core/status.h"
 
 namespace liftoff {
@@ -147,9 +148,16 @@ struct LogReadOptions {
 
 /// Reads a log in liftoff's format. kNotFound for a missing file, kParse for a bad header
 /// or more bad lines than allowed (message: "file:line: what was expected, got ..." for the
-/// first, and the count), kParse "no samples" for an empty log.
+/// first, and the count), kParse "no samples" for an empty log, kInvalidArgument for bad
+/// options. Every error message starts with the file's name.
 Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
                                         const LogReadOptions& options = {});
+
+/// The format of the log at `path` by its first bytes: kLiftoff when it starts with
+/// "# liftoff-log" (after an optional UTF-8 byte-order mark, as ReadControllerLog
+/// accepts), else kLaika2018. kNotFound for a missing file, kInvalidArgument for a folder,
+/// kIo when it cannot be read; every message names the file.
+Result<LogFormat> DetectLogFormat(const std::filesystem::path& path);
 
 /// Writes a whole log (samples and events merged in time order) through a temporary file
 /// renamed into place.

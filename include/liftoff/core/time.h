@@ -18,7 +18,15 @@ inline constexpr int64_t kNanosecondsPerMicrosecond = 1'000;
 inline constexpr int64_t kNanosecondsPerMillisecond = 1'000'000;
 inline constexpr int64_t kNanosecondsPerSecond = 1'000'000'000;
 
+/// The largest number of seconds an option, flag or file may give for a time or a duration
+/// (1e6 s, about 11.6 days: far longer than any trial or capture, and far inside int64
+/// nanoseconds, so sums and differences of a few such times cannot overflow). Readers
+/// reject larger values with kInvalidArgument naming the field.
+inline constexpr double kMaxTimeSeconds = 1e6;
+
 /// Seconds to nanoseconds, rounded to the nearest nanosecond (5.67 -> 5'670'000'000).
+/// Saturates at the int64 limits beyond about +-9.2e9 s; NaN gives 0. Callers bound their
+/// inputs (kMaxTimeSeconds) so neither happens for data a user gave.
 int64_t NsFromSeconds(double seconds);
 /// Nanoseconds to seconds.
 constexpr double SecondsFromNs(int64_t ns) { return static_cast<double>(ns) * 1e-9; }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "liftoff/core/controller_log.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
 #include "liftoff/core/status.h"
 #include "liftoff/core/time.h"
@@ -42,10 +43,17 @@ struct LookupOptions {
   LookupRule rule = LookupRule::kLinear;
   /// Two consecutive samples further apart than this bracket a gap, s (> 0). Inside a gap
   /// the angle is only known to lie between the bracketing samples' values.
+  /// (0, kMaxTimeSeconds].
   double gap_threshold_s = 0.25;
   /// A query up to this long after the last sample (or before the first) is answered with
-  /// the held end value and flagged; further out it is kOutOfRange, s (>= 0).
+  /// the held end value and flagged; further out it is kOutOfRange, s
+  /// ([0, kMaxTimeSeconds]).
   double max_past_end_s = 1.0;
+
+  /// The allowed values of gap_threshold_s and max_past_end_s, s.
+  static constexpr NumberRange kGapThresholdRange{
+      .min = 0.0, .max = kMaxTimeSeconds, .min_exclusive = true};
+  static constexpr NumberRange kMaxPastEndRange{.min = 0.0, .max = kMaxTimeSeconds};
 
   /// kInvalidArgument naming the field and the allowed range.
   Status Validate() const;

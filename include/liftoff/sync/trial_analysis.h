@@ -3,6 +3,7 @@
 // stops the others; each carries its own Status.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,7 +48,7 @@ struct ManifestAnalysis {
   /// The lookup rule used.
   LookupRule rule = LookupRule::kLinear;
   /// Number of outcomes whose status is not OK.
-  int failed = 0;
+  int64_t failed() const;
 
   /// The successful trials' |angles| with their intervals, in manifest order. flags sum up
   /// what to be wary of, separated by "; ": "gap 0.93 s", "past end 0.091 s",
