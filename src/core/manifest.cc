@@ -20,6 +20,7 @@ constexpr int64_t kFormatVersion = 1;
 constexpr NumberRange kTimeRange{.min = 0.0, .max = kMaxTimeSeconds};
 // test numbers: whole and positive, small enough for an int
 constexpr NumberRange kTestNumberRange{.min = 1.0, .max = 1e9};
+constexpr NumberRange kPxPerMmRange{.min = 0.0, .max = 1000.0, .min_exclusive = true};
 
 // The folder relative paths hang from, made absolute so resolved paths are too.
 fs::path AbsoluteDir(const fs::path& dir) {
@@ -126,6 +127,7 @@ TrialRecord ReadTrial(JsonReader& reader, const fs::path& base_dir) {
   }
   if (std::optional<JsonReader> video = reader.OptionalObject("video")) {
     trial.video_path = ReadPath(*video, "path", base_dir, true);
+    trial.px_per_mm = video->OptionalNumber("px_per_mm", kPxPerMmRange);
   }
 
   // what was measured by hand, and where to look in the video
@@ -264,7 +266,10 @@ json ManifestToJson(const TrialManifest& manifest, const fs::path& base_dir) {
     if (trial.rotation) entry["rotation"] = RotationSenseName(*trial.rotation);
     entry["log"] = {{"path", WritePath(trial.log_path, base)},
                     {"format", LogFormatName(trial.log_format)}};
-    if (trial.video_path) entry["video"] = {{"path", WritePath(*trial.video_path, base)}};
+    if (trial.video_path) {
+      entry["video"] = {{"path", WritePath(*trial.video_path, base)}};
+      if (trial.px_per_mm) entry["video"]["px_per_mm"] = *trial.px_per_mm;
+    }
     if (trial.times) {
       entry["times"] = {
           {"led_on_s", SecondsForJson(trial.times->led_on_ns)},

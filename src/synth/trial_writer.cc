@@ -261,6 +261,7 @@ Result<WrittenTrial> WriteTrial(const TrialSpec& spec, const Calibration& calibr
   entry.video_path = written.video_path;
   entry.led_roi_px = truth.led_roi_px;
   entry.foot_roi_px = truth.foot_roi_px;
+  entry.px_per_mm = truth.px_per_mm;
   entry.notes = "synthetic (liftoff synth, seed " + std::to_string(spec.seed) + "); truth in " +
                 written.truth_path.filename().string();
   return written;

@@ -30,7 +30,7 @@ constexpr char kFullManifest[] = R"({
       "pulled_group": "HR",
       "rotation": "-",
       "log": {"path": "logs/Test1 Front Right Blue.txt", "format": "laika-2018"},
-      "video": {"path": "videos/A1.mp4"},
+      "video": {"path": "videos/A1.mp4", "px_per_mm": 1.38},
       "times": {"led_on_s": 1.25, "liftoff_s": 9.27, "led_on_uncertainty_s": 0.017,
                 "liftoff_uncertainty_s": 0.05, "source": "video"},
       "roi": {"led_px": [10, 20, 30, 40], "foot_px": [0, 0, 640, 360]},
@@ -404,6 +404,32 @@ TEST(Manifest, LogFormatNamesRoundTrip) {
   EXPECT_EQ(ParseLogFormat("liftoff"), LogFormat::kLiftoff);
   EXPECT_EQ(ParseLogFormat("laika-2018"), LogFormat::kLaika2018);
   EXPECT_EQ(ParseLogFormat("laika"), std::nullopt);
+}
+
+}  // namespace
+}  // namespace liftoff
+
+namespace liftoff {
+namespace {
+
+TEST(Manifest, PixelScaleIsReadCheckedAndWrittenBack) {
+  testing::ScratchDir dir;
+  testing::WriteFile(dir / "trials.json", kFullManifest);
+  Result<TrialManifest> manifest = LoadManifest(dir / "trials.json");
+  ASSERT_TRUE(manifest.ok()) << manifest.status().ToString();
+  ASSERT_TRUE(manifest->trials[0].px_per_mm.has_value());
+  EXPECT_DOUBLE_EQ(*manifest->trials[0].px_per_mm, 1.38);
+  EXPECT_FALSE(manifest->trials[1].px_per_mm.has_value());
+  const nlohmann::json written = ManifestToJson(*manifest, dir.path());
+  EXPECT_DOUBLE_EQ(written["trials"][0]["video"]["px_per_mm"].get<double>(), 1.38);
+
+  std::string bad = kFullManifest;
+  bad.replace(bad.find("1.38"), 4, "0");
+  testing::WriteFile(dir / "bad.json", bad);
+  const Result<TrialManifest> rejected = LoadManifest(dir / "bad.json");
+  ASSERT_FALSE(rejected.ok());
+  EXPECT_THAT(rejected.status().message(),
+              ::testing::HasSubstr("/trials/0/video/px_per_mm: expected a number > 0"));
 }
 
 }  // namespace

@@ -65,6 +65,10 @@ struct TrialRecord {
   LogFormat log_format = LogFormat::kLiftoff;
   /// Video of the trial, absolute, when there is one.
   std::optional<std::filesystem::path> video_path;
+  /// Image scale at the foot, px per mm of vertical motion, when known (a liftoff
+  /// threshold in mm needs it; video analysis estimates it from the foot's width
+  /// otherwise).
+  std::optional<double> px_per_mm;
   /// Event times read by hand (or by any tool outside liftoff), when given.
   std::optional<EventTimes> times;
   /// Where the LED and the foot are in the video, when given.

@@ -1,0 +1,101 @@
+// Sequential decoding with true per-frame timestamps. Nominal frame rate and the
+// container's frame count are never trusted (both lie for variable-frame-rate files):
+// each frame's time is read from the decoder (OpenCV's FFmpeg backend, CAP_PROP_POS_MSEC)
+// and checked. Known quirk repaired: the last frames of H.264 with B-frames read 0 ms;
+// they are extrapolated from the median interval and marked (Frame::t_repaired).
+// Dropped and irregular frames are reported in FrameTimingReport.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "liftoff/core/status.h"
+#include "liftoff/video/frame.h"
+
+namespace liftoff::video {
+
+/// One frame whose interval to its predecessor is not the usual one.
+struct TimingIrregularity {
+  enum class Kind {
+    kDropped,    ///< interval about n >= 2 usual intervals: n - 1 frames missing
+    kIrregular,  ///< interval off the usual one by more than the tolerance, not a drop
+    kRepaired,   ///< timestamp unreadable (0 or not increasing) and extrapolated
+  };
+  Kind kind = Kind::kIrregular;
+  /// The frame (Frame::index) and its time, ns.
+  int64_t frame_index = 0;
+  int64_t t_ns = 0;
+  /// Interval from the previous frame, ns.
+  int64_t interval_ns = 0;
+  /// kDropped: estimated number of missing frames.
+  int64_t missing_frames = 0;
+};
+
+/// What the timestamps of a whole clip looked like.
+struct FrameTimingReport {
+  int64_t frames = 0;              ///< frames decoded
+  int64_t first_ns = 0;            ///< first frame's time, ns
+  int64_t last_ns = 0;             ///< last frame's time, ns
+  int64_t median_interval_ns = 0;  ///< the usual interval (median of all), ns
+  double container_fps = 0.0;      ///< what the container claims (not used), Hz
+  int64_t container_frames = 0;    ///< what the container claims (not used)
+  int64_t dropped_frames = 0;      ///< sum of missing_frames
+  int64_t repaired_frames = 0;     ///< frames with t_repaired
+  /// Every irregular, dropped or repaired frame, in order (at most max_listed; the counts
+  /// above are complete).
+  std::vector<TimingIrregularity> irregularities;
+  int64_t irregular_frames = 0;    ///< count of kIrregular (complete)
+  /// "1432 frames, 16.667 ms median (60.0 fps), 3 dropped, 2 repaired, 0 irregular".
+  std::string Brief() const;
+};
+
+/// Decodes a video file frame by frame.
+class VideoReader {
+ public:
+  struct Options {
+    /// An interval differing from the median by more than this fraction of it is
+    /// irregular; one near n medians (n >= 2, within the fraction) is n - 1 drops. (0, 1).
+    double irregular_tolerance_frac = 0.25;
+    /// Intervals used to estimate the usual interval on the fly before the whole clip is
+    /// known (for repairs and drop counting while streaming); >= 3.
+    int median_window_frames = 31;
+    /// Most irregularities listed in the report (counts stay complete); >= 0.
+    int max_listed = 1000;
+
+    Status Validate() const;
+  };
+
+  /// Opens `path`. kNotFound when it does not exist; kParse "not a video" when no decoder
+  /// accepts it, or "truncated or damaged" when it looks like a video container (a known
+  /// file signature) but cannot be opened or yields no frame. Messages name the file.
+  static Result<VideoReader> Open(const std::filesystem::path& path, const Options& options);
+  static Result<VideoReader> Open(const std::filesystem::path& path) { return Open(path, Options{}); }
+
+  VideoReader(VideoReader&&) noexcept;
+  VideoReader& operator=(VideoReader&&) noexcept;
+  ~VideoReader();
+
+  /// Decodes the next frame into `frame` (its bgr buffer is reused). Returns false at the
+  /// end of the stream. kParse naming the file and frame when the stream ends in a way
+  /// that shows damage (e.g. decoding stops long before the container's stated length and
+  /// the decoder reported errors): the frames already returned stay valid.
+  Result<bool> Next(Frame& frame);
+
+  /// Image size, px.
+  int width_px() const;
+  int height_px() const;
+  /// The file.
+  const std::filesystem::path& path() const;
+  /// Timing so far (complete once Next returned false).
+  const FrameTimingReport& timing() const;
+
+ private:
+  struct Impl;
+  explicit VideoReader(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace liftoff::video
