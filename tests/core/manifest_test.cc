@@ -429,7 +429,7 @@ TEST(Manifest, PixelScaleIsReadCheckedAndWrittenBack) {
   const Result<TrialManifest> rejected = LoadManifest(dir / "bad.json");
   ASSERT_FALSE(rejected.ok());
   EXPECT_THAT(rejected.status().message(),
-              ::testing::HasSubstr("/trials/0/video/px_per_mm: expected a number > 0"));
+              ::testing::HasSubstr("/trials/0/video/px_per_mm: expected a number in (0, 1000], got 0"));
 }
 
 }  // namespace
