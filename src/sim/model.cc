@@ -1,0 +1,790 @@
+#include "liftoff/sim/model.h"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "liftoff/core/json.h"
+
+namespace liftoff::sim {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::string_view kFormatName = "liftoff-sim-model";
+constexpr int64_t kFormatVersion = 1;
+// Two nodes closer than this are the same point (a rod's tip and a cable's node).
+constexpr double kSamePointM = 1e-9;
+
+constexpr NumberRange kPositive{.min = 0.0, .min_exclusive = true};
+constexpr NumberRange kNonNegative{.min = 0.0};
+constexpr NumberRange kUnit{.min = 0.0, .max = 1.0};
+
+std::string Join(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) {
+    if (!text.empty()) text += ", ";
+    text += name;
+  }
+  return text;
+}
+
+// Collects the first problem, named by its JSON pointer.
+class Checker {
+ public:
+  explicit Checker(std::string source) : source_(std::move(source)) {}
+  void Fail(const std::string& pointer, const std::string& message) {
+    if (!status_.ok()) return;
+    status_ =
+        InvalidArgumentError((source_.empty() ? "" : source_ + ": ") + pointer + ": " + message);
+  }
+  void Unsupported(const std::string& pointer, const std::string& message) {
+    if (!status_.ok()) return;
+    status_ = UnsupportedError((source_.empty() ? "" : source_ + ": ") + pointer + ": " + message);
+  }
+  void Number(const std::string& pointer, double value, const NumberRange& range) {
+    if (!InNumberRange(value, range)) {
+      Fail(pointer, "expected " + DescribeNumberRange(range) + ", got " + FormatNumber(value));
+    }
+  }
+  void Vector(const std::string& pointer, const Vec3& value) {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(value[i])) {
+        Fail(pointer + "/" + std::to_string(i), "expected a number, got " + FormatNumber(value[i]));
+      }
+    }
+  }
+  void Name(const std::string& pointer, const std::string& name) {
+    if (name.empty()) Fail(pointer, "expected a non-empty name");
+    if (name.find('/') != std::string::npos) Fail(pointer, "expected a name without '/'");
+  }
+  bool ok() const { return status_.ok(); }
+  Status status() const { return status_; }
+
+ private:
+  std::string source_;
+  Status status_;
+};
+
+std::string At(std::string_view array, size_t i) {
+  return std::string(array) + "/" + std::to_string(i);
+}
+
+Vec3 ToVec3(const std::vector<double>& values) {
+  if (values.size() != 3) return Vec3::Zero();
+  return Vec3(values[0], values[1], values[2]);
+}
+
+json ToJson(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+// "rear/top" -> ("rear", "top"); nullopt without exactly one '/'.
+std::optional<std::pair<std::string, std::string>> SplitEnd(const std::string& end) {
+  const size_t slash = end.find('/');
+  if (slash == std::string::npos || end.find('/', slash + 1) != std::string::npos) {
+    return std::nullopt;
+  }
+  return std::make_pair(end.substr(0, slash), end.substr(slash + 1));
+}
+
+}  // namespace
+
+std::string_view CableAttachmentName(CableAttachment attachment) {
+  return attachment == CableAttachment::kNode ? "node" : "surface";
+}
+
+std::string_view RestLengthReferenceName(RestLengthReference reference) {
+  return reference == RestLengthReference::kNode ? "node" : "attachment";
+}
+
+// ---------------------------------------------------------------------------------------
+// mass properties
+
+MassProperties RodMassProperties(const Vec3& from_m, const Vec3& to_m, double radius_m,
+                                 double density_kg_per_m3) {
+  MassProperties props;
+  const Vec3 axis = to_m - from_m;
+  const double length = axis.norm();
+  props.mass_kg = density_kg_per_m3 * std::numbers::pi * radius_m * radius_m * length;
+  props.com_m = 0.5 * (from_m + to_m);
+  if (length <= 0.0) return props;
+  // solid cylinder: m r^2 / 2 about its axis, m (3 r^2 + L^2) / 12 across it
+  const Vec3 d = axis / length;
+  const double axial = 0.5 * props.mass_kg * radius_m * radius_m;
+  const double across = props.mass_kg * (3.0 * radius_m * radius_m + length * length) / 12.0;
+  props.inertia_kg_m2 = across * (Mat3::Identity() - d * d.transpose()) + axial * d * d.transpose();
+  return props;
+}
+
+MassProperties BoxMassProperties(const Vec3& center_m, const Vec3& size_m,
+                                 double density_kg_per_m3) {
+  MassProperties props;
+  props.mass_kg = density_kg_per_m3 * size_m.x() * size_m.y() * size_m.z();
+  props.com_m = center_m;
+  const Vec3 s2 = size_m.cwiseProduct(size_m);
+  props.inertia_kg_m2 =
+      (props.mass_kg / 12.0) * Vec3(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y()).asDiagonal();
+  return props;
+}
+
+MassProperties SphereMassProperties(const Vec3& center_m, double radius_m,
+                                    double density_kg_per_m3) {
+  MassProperties props;
+  props.mass_kg = density_kg_per_m3 * 4.0 / 3.0 * std::numbers::pi * radius_m * radius_m * radius_m;
+  props.com_m = center_m;
+  props.inertia_kg_m2 = 0.4 * props.mass_kg * radius_m * radius_m * Mat3::Identity();
+  return props;
+}
+
+MassProperties CombineMassProperties(const std::vector<MassProperties>& parts) {
+  MassProperties total;
+  for (const MassProperties& part : parts) {
+    total.mass_kg += part.mass_kg;
+    total.com_m += part.mass_kg * part.com_m;
+  }
+  if (total.mass_kg <= 0.0) return MassProperties{};
+  total.com_m /= total.mass_kg;
+  // parallel axis theorem for each part
+  for (const MassProperties& part : parts) {
+    const Vec3 offset = part.com_m - total.com_m;
+    total.inertia_kg_m2 +=
+        part.inertia_kg_m2 +
+        part.mass_kg * (offset.squaredNorm() * Mat3::Identity() - offset * offset.transpose());
+  }
+  return total;
+}
+
+Vec3 SurfaceAnchor(const Vec3& node, const Vec3& rod_direction, double radius_m,
+                   const Vec3& destination) {
+  const double rod_length = rod_direction.norm();
+  if (rod_length <= 0.0) return node;
+  const Vec3 axis = rod_direction / rod_length;
+  const Vec3 towards = destination - node;
+  // the part of the way to the destination that is perpendicular to the rod
+  const Vec3 across = towards - axis * axis.dot(towards);
+  const double across_length = across.norm();
+  if (across_length <= 1e-12 * std::max(1.0, towards.norm())) return node;
+  return node + across * (radius_m / across_length);
+}
+
+// ---------------------------------------------------------------------------------------
+// reading and writing the file format
+
+Result<ModelDescription> ModelDescriptionFromJson(const json& document, const std::string& source) {
+  if (!document.is_object()) {
+    return InvalidArgumentError(source + ": /: expected a JSON object");
+  }
+  JsonReader root(document, source);
+  const std::string format = root.String("format");
+  if (!root.failed() && format != kFormatName) {
+    return UnsupportedError(root.Where("format") + ": expected \"" + std::string(kFormatName) +
+                            "\", got \"" + format + "\"");
+  }
+  const int64_t version = root.Integer("version", {.min = 1});
+  if (!root.failed() && version > kFormatVersion) {
+    return UnsupportedError(root.Where("version") + ": version " + std::to_string(version) +
+                            " is newer than this program reads (" + std::to_string(kFormatVersion) +
+                            ")");
+  }
+
+  ModelDescription model;
+  model.name = root.String("name");
+  model.description = root.OptionalString("description").value_or("");
+  model.gravity_m_per_s2 = ToVec3(root.NumberArray("gravity_m_per_s2", 3));
+  if (auto contact = root.OptionalObject("contact")) {
+    model.contact.friction = contact->OptionalNumber("friction", kNonNegative).value_or(0.0);
+    model.contact.spine_friction = contact->OptionalNumber("spine_friction", kNonNegative);
+    model.contact.restitution = contact->OptionalNumber("restitution", kUnit).value_or(0.0);
+    model.contact.spine_ground = contact->OptionalBoolean("spine_ground").value_or(false);
+    model.contact.spine_self = contact->OptionalBoolean("spine_self").value_or(false);
+  }
+  if (auto attachment = root.OptionalEnum("cable_attachment", {"node", "surface"})) {
+    model.cable_attachment = *attachment == 0 ? CableAttachment::kNode : CableAttachment::kSurface;
+  }
+  if (auto reference = root.OptionalEnum("rest_length_reference", {"attachment", "node"})) {
+    model.rest_length_reference =
+        *reference == 0 ? RestLengthReference::kAttachment : RestLengthReference::kNode;
+  }
+  model.damping_cap = root.OptionalBoolean("damping_cap").value_or(true);
+  model.foot_marker_height_m =
+      root.OptionalNumber("foot_marker_height_m", kNonNegative).value_or(0.0);
+
+  // bodies: nodes, rods, boxes, spheres
+  for (JsonReader& body_reader : root.ObjectArray("bodies")) {
+    BodyDescription body;
+    body.name = body_reader.String("name");
+    body.position_m = ToVec3(body_reader.NumberArray("position_m", 3));
+    if (auto wxyz = body_reader.OptionalNumberArray("orientation_wxyz", 4)) {
+      if (wxyz->size() == 4)
+        body.orientation = Quat((*wxyz)[0], (*wxyz)[1], (*wxyz)[2], (*wxyz)[3]);
+    }
+    const json* nodes = body_reader.Raw("nodes");
+    if (nodes == nullptr || !nodes->is_object()) {
+      body_reader.Fail("nodes", "expected an object of named points, {\"top\": [x, y, z], ...}");
+    } else {
+      JsonReader nodes_reader = body_reader.Object("nodes");
+      for (const auto& [node_name, value] : nodes->items()) {
+        body.nodes.push_back({node_name, ToVec3(nodes_reader.NumberArray(node_name, 3))});
+      }
+    }
+    if (auto rods = body_reader.OptionalObjectArray("rods")) {
+      for (JsonReader& rod_reader : *rods) {
+        RodDescription rod;
+        rod.name = rod_reader.String("name");
+        rod.from_node = rod_reader.String("from");
+        rod.to_node = rod_reader.String("to");
+        rod.radius_m = rod_reader.Number("radius_m", kPositive);
+        rod.density_kg_per_m3 = rod_reader.Number("density_kg_per_m3", kNonNegative);
+        rod.collides = rod_reader.OptionalBoolean("collides").value_or(true);
+        body.rods.push_back(std::move(rod));
+      }
+    }
+    if (auto boxes = body_reader.OptionalObjectArray("boxes")) {
+      for (JsonReader& box_reader : *boxes) {
+        BoxDescription box;
+        box.name = box_reader.String("name");
+        box.center_m = ToVec3(box_reader.NumberArray("center_m", 3));
+        box.size_m = ToVec3(box_reader.NumberArray("size_m", 3, kPositive));
+        box.density_kg_per_m3 = box_reader.Number("density_kg_per_m3", kNonNegative);
+        box.collides = box_reader.OptionalBoolean("collides").value_or(true);
+        body.boxes.push_back(std::move(box));
+      }
+    }
+    if (auto spheres = body_reader.OptionalObjectArray("spheres")) {
+      for (JsonReader& sphere_reader : *spheres) {
+        SphereDescription sphere;
+        sphere.name = sphere_reader.String("name");
+        sphere.center_m = ToVec3(sphere_reader.NumberArray("center_m", 3));
+        sphere.radius_m = sphere_reader.Number("radius_m", kPositive);
+        sphere.density_kg_per_m3 = sphere_reader.Number("density_kg_per_m3", kNonNegative);
+        if (auto foot = sphere_reader.OptionalEnum("foot", {"A", "B", "C", "D"})) {
+          sphere.foot = static_cast<Foot>(*foot);
+        }
+        body.spheres.push_back(std::move(sphere));
+      }
+    }
+    model.bodies.push_back(std::move(body));
+  }
+
+  if (auto hinges = root.OptionalObjectArray("hinges")) {
+    for (JsonReader& hinge_reader : *hinges) {
+      HingeDescription hinge;
+      hinge.name = hinge_reader.String("name");
+      hinge.parent = hinge_reader.String("parent");
+      hinge.child = hinge_reader.String("child");
+      hinge.point_m = ToVec3(hinge_reader.NumberArray("point_m", 3));
+      hinge.axis = ToVec3(hinge_reader.NumberArray("axis", 3));
+      model.hinges.push_back(std::move(hinge));
+    }
+  }
+
+  for (JsonReader& group_reader : root.ObjectArray("cable_groups")) {
+    CableGroupDescription group;
+    group.name = group_reader.String("name");
+    group.material = group_reader.OptionalString("material").value_or("");
+    group.stiffness_n_per_m = group_reader.Number("stiffness_n_per_m", kPositive);
+    group.damping_n_s_per_m = group_reader.Number("damping_n_s_per_m", kNonNegative);
+    group.pretension_n = group_reader.Number("pretension_n", kNonNegative);
+    model.cable_groups.push_back(std::move(group));
+  }
+
+  std::vector<JsonReader> cable_readers = root.ObjectArray("cables");
+  for (JsonReader& cable_reader : cable_readers) {
+    CableDescription cable;
+    cable.name = cable_reader.String("name");
+    cable.group = cable_reader.String("group");
+    const std::string from = cable_reader.String("from");
+    const std::string to = cable_reader.String("to");
+    const auto from_end = SplitEnd(from);
+    const auto to_end = SplitEnd(to);
+    if (!cable_reader.failed() && !from_end) {
+      cable_reader.Fail("from", "expected \"<body>/<node>\", got \"" + from + "\"");
+    }
+    if (!cable_reader.failed() && !to_end) {
+      cable_reader.Fail("to", "expected \"<body>/<node>\", got \"" + to + "\"");
+    }
+    if (from_end) std::tie(cable.from_body, cable.from_node) = *from_end;
+    if (to_end) std::tie(cable.to_body, cable.to_node) = *to_end;
+    model.cables.push_back(std::move(cable));
+  }
+
+  LIFTOFF_RETURN_IF_ERROR(root.Finish());
+  // the description's own consistency, with the file's pointers
+  Result<Model> built = BuildModel(model, source);
+  if (!built.ok()) return built.status();
+  return model;
+}
+
+Result<ModelDescription> LoadModelDescription(const std::filesystem::path& path) {
+  LIFTOFF_ASSIGN_OR_RETURN(json document, LoadJsonFile(path));
+  return ModelDescriptionFromJson(document, path.string());
+}
+
+json ModelDescriptionToJson(const ModelDescription& model) {
+  json document = json::object();
+  document["format"] = kFormatName;
+  document["version"] = kFormatVersion;
+  document["name"] = model.name;
+  if (!model.description.empty()) document["description"] = model.description;
+  document["gravity_m_per_s2"] = ToJson(model.gravity_m_per_s2);
+  document["contact"] = {{"friction", model.contact.friction},
+                         {"restitution", model.contact.restitution},
+                         {"spine_ground", model.contact.spine_ground},
+                         {"spine_self", model.contact.spine_self}};
+  if (model.contact.spine_friction) {
+    document["contact"]["spine_friction"] = *model.contact.spine_friction;
+  }
+  document["cable_attachment"] = std::string(CableAttachmentName(model.cable_attachment));
+  document["rest_length_reference"] =
+      std::string(RestLengthReferenceName(model.rest_length_reference));
+  document["damping_cap"] = model.damping_cap;
+  document["foot_marker_height_m"] = model.foot_marker_height_m;
+  json bodies = json::array();
+  for (const BodyDescription& body : model.bodies) {
+    json entry = {{"name", body.name}, {"position_m", ToJson(body.position_m)}};
+    const Quat& q = body.orientation;
+    if (!q.coeffs().isApprox(Quat::Identity().coeffs(), 0.0)) {
+      entry["orientation_wxyz"] = json::array({q.w(), q.x(), q.y(), q.z()});
+    }
+    json nodes = json::object();
+    for (const NodeDescription& node : body.nodes) nodes[node.name] = ToJson(node.position_m);
+    entry["nodes"] = nodes;
+    json rods = json::array();
+    for (const RodDescription& rod : body.rods) {
+      rods.push_back({{"name", rod.name},
+                      {"from", rod.from_node},
+                      {"to", rod.to_node},
+                      {"radius_m", rod.radius_m},
+                      {"density_kg_per_m3", rod.density_kg_per_m3},
+                      {"collides", rod.collides}});
+    }
+    if (!rods.empty()) entry["rods"] = rods;
+    json boxes = json::array();
+    for (const BoxDescription& box : body.boxes) {
+      boxes.push_back({{"name", box.name},
+                       {"center_m", ToJson(box.center_m)},
+                       {"size_m", ToJson(box.size_m)},
+                       {"density_kg_per_m3", box.density_kg_per_m3},
+                       {"collides", box.collides}});
+    }
+    if (!boxes.empty()) entry["boxes"] = boxes;
+    json spheres = json::array();
+    for (const SphereDescription& sphere : body.spheres) {
+      json item = {{"name", sphere.name},
+                   {"center_m", ToJson(sphere.center_m)},
+                   {"radius_m", sphere.radius_m},
+                   {"density_kg_per_m3", sphere.density_kg_per_m3}};
+      if (sphere.foot) item["foot"] = std::string(FootName(*sphere.foot));
+      spheres.push_back(item);
+    }
+    if (!spheres.empty()) entry["spheres"] = spheres;
+    bodies.push_back(entry);
+  }
+  document["bodies"] = bodies;
+  json hinges = json::array();
+  for (const HingeDescription& hinge : model.hinges) {
+    hinges.push_back({{"name", hinge.name},
+                      {"parent", hinge.parent},
+                      {"child", hinge.child},
+                      {"point_m", ToJson(hinge.point_m)},
+                      {"axis", ToJson(hinge.axis)}});
+  }
+  if (!hinges.empty()) document["hinges"] = hinges;
+  json groups = json::array();
+  for (const CableGroupDescription& group : model.cable_groups) {
+    json entry = {{"name", group.name},
+                  {"stiffness_n_per_m", group.stiffness_n_per_m},
+                  {"damping_n_s_per_m", group.damping_n_s_per_m},
+                  {"pretension_n", group.pretension_n}};
+    if (!group.material.empty()) entry["material"] = group.material;
+    groups.push_back(entry);
+  }
+  document["cable_groups"] = groups;
+  json cables = json::array();
+  for (const CableDescription& cable : model.cables) {
+    cables.push_back({{"name", cable.name},
+                      {"group", cable.group},
+                      {"from", cable.from_body + "/" + cable.from_node},
+                      {"to", cable.to_body + "/" + cable.to_node}});
+  }
+  document["cables"] = cables;
+  return document;
+}
+
+// ---------------------------------------------------------------------------------------
+// building
+
+int Model::BodyIndex(std::string_view name) const {
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int Model::CableGroupIndex(std::string_view name) const {
+  for (size_t i = 0; i < cable_groups.size(); ++i) {
+    if (cable_groups[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::vector<int> Model::CablesInGroup(std::string_view group) const {
+  std::vector<int> indices;
+  const int index = CableGroupIndex(group);
+  if (index < 0) return indices;
+  for (size_t i = 0; i < cables.size(); ++i) {
+    if (cables[i].group == index) indices.push_back(static_cast<int>(i));
+  }
+  return indices;
+}
+
+std::string Model::Brief() const {
+  std::ostringstream out;
+  out << description.name << ": " << bodies.size() << (bodies.size() == 1 ? " body" : " bodies")
+      << " (" << FormatNumber(std::round(total_mass_kg * 1e4) / 1e4) << " kg), " << hinges.size()
+      << (hinges.size() == 1 ? " hinge, " : " hinges, ") << cables.size()
+      << (cables.size() == 1 ? " cable, " : " cables, ") << feet.size()
+      << (feet.size() == 1 ? " foot, " : " feet, ")
+      << CableAttachmentName(description.cable_attachment) << " attachment";
+  return out.str();
+}
+
+Result<Model> BuildModel(const ModelDescription& description, const std::string& source) {
+  Checker check(source);
+  Model model;
+  model.description = description;
+  model.gravity_m_per_s2 = description.gravity_m_per_s2;
+  model.contact = description.contact;
+  model.damping_cap = description.damping_cap;
+
+  // world settings
+  check.Name("/name", description.name);
+  check.Vector("/gravity_m_per_s2", description.gravity_m_per_s2);
+  check.Number("/contact/friction", description.contact.friction, kNonNegative);
+  check.Number("/contact/restitution", description.contact.restitution, kUnit);
+  check.Number("/foot_marker_height_m", description.foot_marker_height_m, kNonNegative);
+  if (description.contact.spine_friction) {
+    check.Number("/contact/spine_friction", *description.contact.spine_friction, kNonNegative);
+  }
+  if (description.bodies.empty()) check.Fail("/bodies", "expected at least one body");
+
+  // bodies: names, nodes, shapes, mass properties
+  std::map<std::string, int, std::less<>> body_index;
+  std::vector<std::string> body_names;
+  for (size_t b = 0; b < description.bodies.size(); ++b) {
+    const BodyDescription& in = description.bodies[b];
+    const std::string where = At("/bodies", b);
+    check.Name(where + "/name", in.name);
+    if (!body_index.emplace(in.name, static_cast<int>(b)).second) {
+      check.Fail(where + "/name", "body \"" + in.name + "\" is listed twice");
+    }
+    body_names.push_back(in.name);
+    check.Vector(where + "/position_m", in.position_m);
+    const double q_norm = in.orientation.norm();
+    if (!in.orientation.coeffs().allFinite() || std::abs(q_norm - 1.0) > 1e-6) {
+      check.Fail(where + "/orientation_wxyz", "expected a unit quaternion [w, x, y, z]");
+    }
+
+    Body body;
+    body.name = in.name;
+    body.initial_position_m = in.position_m;
+    body.initial_orientation = q_norm > 0.0 ? in.orientation.normalized() : Quat::Identity();
+    body.nodes = in.nodes;
+    std::map<std::string, Vec3, std::less<>> nodes;
+    for (size_t n = 0; n < in.nodes.size(); ++n) {
+      const std::string node_where = where + "/nodes/" + JsonPointerEscape(in.nodes[n].name);
+      check.Name(node_where, in.nodes[n].name);
+      check.Vector(node_where, in.nodes[n].position_m);
+      if (!nodes.emplace(in.nodes[n].name, in.nodes[n].position_m).second) {
+        check.Fail(node_where, "node \"" + in.nodes[n].name + "\" is listed twice");
+      }
+    }
+    auto node_names = [&]() {
+      std::vector<std::string> names;
+      for (const auto& [name, position] : nodes) names.push_back(name);
+      return Join(names);
+    };
+
+    std::vector<MassProperties> parts;
+    for (size_t r = 0; r < in.rods.size(); ++r) {
+      const RodDescription& rod_in = in.rods[r];
+      const std::string rod_where = At(where + "/rods", r);
+      check.Number(rod_where + "/radius_m", rod_in.radius_m, kPositive);
+      check.Number(rod_where + "/density_kg_per_m3", rod_in.density_kg_per_m3, kNonNegative);
+      const auto from = nodes.find(rod_in.from_node);
+      const auto to = nodes.find(rod_in.to_node);
+      if (from == nodes.end()) {
+        check.Fail(rod_where + "/from", "unknown node \"" + rod_in.from_node + "\"; body " +
+                                            in.name + " has " + node_names());
+        continue;
+      }
+      if (to == nodes.end()) {
+        check.Fail(rod_where + "/to", "unknown node \"" + rod_in.to_node + "\"; body " + in.name +
+                                          " has " + node_names());
+        continue;
+      }
+      if ((to->second - from->second).norm() <= kSamePointM) {
+        check.Fail(rod_where, "expected a rod of positive length (from and to coincide)");
+        continue;
+      }
+      const MassProperties props =
+          RodMassProperties(from->second, to->second, rod_in.radius_m, rod_in.density_kg_per_m3);
+      parts.push_back(props);
+      body.rods.push_back(
+          {rod_in.name, from->second, to->second, rod_in.radius_m, props.mass_kg, rod_in.collides});
+    }
+    for (size_t x = 0; x < in.boxes.size(); ++x) {
+      const BoxDescription& box_in = in.boxes[x];
+      const std::string box_where = At(where + "/boxes", x);
+      check.Vector(box_where + "/center_m", box_in.center_m);
+      for (int i = 0; i < 3; ++i) {
+        check.Number(box_where + "/size_m/" + std::to_string(i), box_in.size_m[i], kPositive);
+      }
+      check.Number(box_where + "/density_kg_per_m3", box_in.density_kg_per_m3, kNonNegative);
+      const MassProperties props =
+          BoxMassProperties(box_in.center_m, box_in.size_m, box_in.density_kg_per_m3);
+      parts.push_back(props);
+      body.boxes.push_back(
+          {box_in.name, box_in.center_m, 0.5 * box_in.size_m, props.mass_kg, box_in.collides});
+    }
+    for (size_t s = 0; s < in.spheres.size(); ++s) {
+      const SphereDescription& sphere_in = in.spheres[s];
+      const std::string sphere_where = At(where + "/spheres", s);
+      check.Vector(sphere_where + "/center_m", sphere_in.center_m);
+      check.Number(sphere_where + "/radius_m", sphere_in.radius_m, kPositive);
+      check.Number(sphere_where + "/density_kg_per_m3", sphere_in.density_kg_per_m3, kNonNegative);
+      const MassProperties props =
+          SphereMassProperties(sphere_in.center_m, sphere_in.radius_m, sphere_in.density_kg_per_m3);
+      parts.push_back(props);
+      Sphere sphere{
+          sphere_in.name, sphere_in.center_m, sphere_in.radius_m, props.mass_kg, -1, true};
+      if (sphere_in.foot) {
+        const int letter = static_cast<int>(*sphere_in.foot);
+        if (model.foot_index[static_cast<size_t>(letter)] >= 0) {
+          check.Fail(sphere_where + "/foot",
+                     "foot " + std::string(FootName(*sphere_in.foot)) + " is given twice");
+        } else {
+          FootPoint foot;
+          foot.foot = *sphere_in.foot;
+          foot.body = static_cast<int>(b);
+          foot.center_m = sphere_in.center_m;
+          foot.radius_m = sphere_in.radius_m;
+          // the sphere's lowest point in the built pose, fixed to the body from then on
+          const Quat body_from_world = body.initial_orientation.conjugate();
+          foot.bottom_m =
+              sphere_in.center_m + body_from_world * Vec3(0.0, 0.0, -sphere_in.radius_m);
+          foot.marker_m =
+              foot.bottom_m + body_from_world * Vec3(0.0, 0.0, description.foot_marker_height_m);
+          sphere.foot_index = static_cast<int>(model.feet.size());
+          model.foot_index[static_cast<size_t>(letter)] = sphere.foot_index;
+          model.feet.push_back(foot);
+        }
+      }
+      body.spheres.push_back(sphere);
+    }
+    const MassProperties total = CombineMassProperties(parts);
+    body.mass_kg = total.mass_kg;
+    body.com_m = total.com_m;
+    body.inertia_kg_m2 = total.inertia_kg_m2;
+    model.total_mass_kg += total.mass_kg;
+    model.bodies.push_back(std::move(body));
+  }
+  if (!check.ok()) return check.status();
+
+  // hinges: a child is driven by its parent, which must be free
+  for (size_t h = 0; h < description.hinges.size(); ++h) {
+    const HingeDescription& in = description.hinges[h];
+    const std::string where = At("/hinges", h);
+    check.Name(where + "/name", in.name);
+    const auto parent = body_index.find(in.parent);
+    const auto child = body_index.find(in.child);
+    if (parent == body_index.end()) {
+      check.Fail(where + "/parent",
+                 "unknown body \"" + in.parent + "\"; bodies are " + Join(body_names));
+      continue;
+    }
+    if (child == body_index.end()) {
+      check.Fail(where + "/child",
+                 "unknown body \"" + in.child + "\"; bodies are " + Join(body_names));
+      continue;
+    }
+    if (parent->second == child->second) {
+      check.Fail(where + "/child", "expected a body other than the parent");
+      continue;
+    }
+    check.Vector(where + "/point_m", in.point_m);
+    check.Vector(where + "/axis", in.axis);
+    if (check.ok() && in.axis.norm() < 1e-12)
+      check.Fail(where + "/axis", "expected a non-zero axis");
+    Body& child_body = model.bodies[static_cast<size_t>(child->second)];
+    if (child_body.driving_hinge >= 0) {
+      check.Fail(where + "/child", "body \"" + in.child + "\" is already driven by a hinge");
+      continue;
+    }
+    child_body.driving_hinge = static_cast<int>(h);
+    Hinge hinge;
+    hinge.name = in.name;
+    hinge.parent = parent->second;
+    hinge.child = child->second;
+    hinge.point_m = in.point_m;
+    hinge.axis = in.axis.norm() > 0.0 ? in.axis.normalized() : Vec3::UnitX();
+    const Body& parent_body = model.bodies[static_cast<size_t>(parent->second)];
+    const Quat parent_inverse = parent_body.initial_orientation.conjugate();
+    hinge.child_position_in_parent_m =
+        parent_inverse * (child_body.initial_position_m - parent_body.initial_position_m);
+    hinge.child_orientation_in_parent = parent_inverse * child_body.initial_orientation;
+    model.hinges.push_back(hinge);
+  }
+  for (size_t h = 0; h < model.hinges.size(); ++h) {
+    const Hinge& hinge = model.hinges[h];
+    if (model.bodies[static_cast<size_t>(hinge.parent)].driving_hinge >= 0) {
+      check.Unsupported(At("/hinges", h) + "/parent",
+                        "a hinge's parent must be a free body (chains of hinges are not "
+                        "supported)");
+    }
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const Body& body = model.bodies[b];
+    if (body.driving_hinge < 0 && !(body.mass_kg > 0.0)) {
+      check.Fail(At("/bodies", b),
+                 "body \"" + body.name + "\" has no mass; give it a shape with a density > 0");
+    }
+  }
+  if (!check.ok()) return check.status();
+
+  // cable groups
+  std::map<std::string, int, std::less<>> group_index;
+  std::vector<std::string> group_names;
+  for (size_t g = 0; g < description.cable_groups.size(); ++g) {
+    const CableGroupDescription& group = description.cable_groups[g];
+    const std::string where = At("/cable_groups", g);
+    check.Name(where + "/name", group.name);
+    if (!group_index.emplace(group.name, static_cast<int>(g)).second) {
+      check.Fail(where + "/name", "cable group \"" + group.name + "\" is listed twice");
+    }
+    group_names.push_back(group.name);
+    check.Number(where + "/stiffness_n_per_m", group.stiffness_n_per_m, kPositive);
+    check.Number(where + "/damping_n_s_per_m", group.damping_n_s_per_m, kNonNegative);
+    check.Number(where + "/pretension_n", group.pretension_n, kNonNegative);
+  }
+  model.cable_groups = description.cable_groups;
+  if (!check.ok()) return check.status();
+
+  // cables: ends, anchors, rest lengths
+  auto world_point = [&](int body, const Vec3& local) {
+    const Body& b = model.bodies[static_cast<size_t>(body)];
+    return Vec3(b.initial_position_m + b.initial_orientation * local);
+  };
+  std::set<std::string, std::less<>> cable_names;
+  for (size_t c = 0; c < description.cables.size(); ++c) {
+    const CableDescription& in = description.cables[c];
+    const std::string where = At("/cables", c);
+    check.Name(where + "/name", in.name);
+    if (!cable_names.insert(in.name).second) {
+      check.Fail(where + "/name", "cable \"" + in.name + "\" is listed twice");
+    }
+    const auto group = group_index.find(in.group);
+    if (group == group_index.end()) {
+      check.Fail(where + "/group",
+                 "unknown cable group \"" + in.group + "\"; groups are " + Join(group_names));
+      continue;
+    }
+    // each end: body and node
+    struct End {
+      int body = -1;
+      Vec3 node = Vec3::Zero();
+    };
+    auto find_end = [&](const std::string& key, const std::string& body_name,
+                        const std::string& node_name) -> std::optional<End> {
+      const auto body = body_index.find(body_name);
+      if (body == body_index.end()) {
+        check.Fail(where + "/" + key, "unknown node \"" + body_name + "/" + node_name +
+                                          "\": no body \"" + body_name + "\"; bodies are " +
+                                          Join(body_names));
+        return std::nullopt;
+      }
+      const Body& b = model.bodies[static_cast<size_t>(body->second)];
+      std::vector<std::string> names;
+      for (const NodeDescription& node : b.nodes) {
+        if (node.name == node_name) return End{body->second, node.position_m};
+        names.push_back(node.name);
+      }
+      check.Fail(where + "/" + key, "unknown node \"" + body_name + "/" + node_name + "\"; body " +
+                                        body_name + " has " + Join(names));
+      return std::nullopt;
+    };
+    const std::optional<End> a = find_end("from", in.from_body, in.from_node);
+    const std::optional<End> b = find_end("to", in.to_body, in.to_node);
+    if (!a || !b) continue;
+    if (a->body == b->body) {
+      check.Fail(where + "/to",
+                 "expected a node on another body than the cable's start (" + in.from_body + ")");
+      continue;
+    }
+    const CableGroupDescription& group_in =
+        description.cable_groups[static_cast<size_t>(group->second)];
+    Cable cable;
+    cable.name = in.name;
+    cable.group = group->second;
+    cable.body_a = a->body;
+    cable.body_b = b->body;
+    cable.node_a_m = a->node;
+    cable.node_b_m = b->node;
+    cable.stiffness_n_per_m = group_in.stiffness_n_per_m;
+    cable.damping_n_s_per_m = group_in.damping_n_s_per_m;
+    cable.pretension_n = group_in.pretension_n;
+    const Vec3 node_a_world = world_point(a->body, a->node);
+    const Vec3 node_b_world = world_point(b->body, b->node);
+    cable.initial_node_length_m = (node_b_world - node_a_world).norm();
+    if (cable.initial_node_length_m <= kSamePointM) {
+      check.Fail(where, "expected its two nodes apart in the built pose");
+      continue;
+    }
+    // surface anchors: the rod ending at the node, moved towards the other node
+    auto anchor = [&](int body, const Vec3& node, const Vec3& destination_world) {
+      if (description.cable_attachment == CableAttachment::kNode) return node;
+      const Body& owner = model.bodies[static_cast<size_t>(body)];
+      const Rod* tip_of = nullptr;
+      int tips = 0;
+      for (const Rod& rod : owner.rods) {
+        const bool at_from = (rod.from_m - node).norm() <= kSamePointM;
+        const bool at_to = (rod.to_m - node).norm() <= kSamePointM;
+        if (at_from || at_to) {
+          ++tips;
+          tip_of = &rod;
+        }
+      }
+      if (tips != 1 || tip_of == nullptr) return node;
+      const Vec3 destination =
+          owner.initial_orientation.conjugate() * (destination_world - owner.initial_position_m);
+      return SurfaceAnchor(node, tip_of->to_m - tip_of->from_m, tip_of->radius_m, destination);
+    };
+    cable.anchor_a_m = anchor(a->body, a->node, node_b_world);
+    cable.anchor_b_m = anchor(b->body, b->node, node_a_world);
+    cable.initial_length_m =
+        (world_point(b->body, cable.anchor_b_m) - world_point(a->body, cable.anchor_a_m)).norm();
+    const double reference = description.rest_length_reference == RestLengthReference::kNode
+                                 ? cable.initial_node_length_m
+                                 : cable.initial_length_m;
+    cable.rest_length_m = reference - cable.pretension_n / cable.stiffness_n_per_m;
+    if (!(cable.rest_length_m > 0.0)) {
+      check.Fail(where, "its pretension " + FormatNumber(cable.pretension_n) + " N over k " +
+                            FormatNumber(cable.stiffness_n_per_m) + " N/m exceeds its length " +
+                            FormatNumber(reference) + " m: the rest length would be <= 0");
+      continue;
+    }
+    model.cables.push_back(std::move(cable));
+  }
+  if (!check.ok()) return check.status();
+  return model;
+}
+
+Result<Model> LoadModel(const std::filesystem::path& path) {
+  LIFTOFF_ASSIGN_OR_RETURN(ModelDescription description, LoadModelDescription(path));
+  return BuildModel(description, path.string());
+}
+
+}  // namespace liftoff::sim

@@ -1,0 +1,283 @@
+#include "liftoff/sim/sweep.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
+
+namespace liftoff::sim {
+namespace {
+
+constexpr int kMaxThreads = 1024;
+
+size_t Index(int i) { return static_cast<size_t>(i); }
+
+std::string RunName(Foot foot, const TensionPoint& tension) {
+  return "run " + std::string(FootName(foot)) + " " + tension.name;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// one run, with progress
+
+Status RunControl::Validate() const {
+  if (!(progress_period_s > 0.0 && progress_period_s <= 3600.0)) {
+    return InvalidArgumentError("progress_period_s: expected a number in (0, 3600], got " +
+                                FormatNumber(progress_period_s));
+  }
+  return Status::Ok();
+}
+
+Result<ExperimentResult> RunExperimentWithProgress(const ModelDescription& description,
+                                                   const ExperimentOptions& options,
+                                                   const RunControl& control,
+                                                   const RunProgressCallback& progress) {
+  LIFTOFF_RETURN_IF_ERROR(control.Validate());
+  LIFTOFF_ASSIGN_OR_RETURN(Model model, BuildExperimentModel(description, options));
+  const Procedure procedure(model, options);
+  LiftoffRecorder recorder(model, options);
+  State state = InitialState(model, options.drop_height_m);
+  Controls controls;
+  controls.rest_length_m.resize(model.cables.size());
+  controls.hinge_angle_rad.resize(1);
+  const double end_time_s = procedure.TimeAt(procedure.step_count());
+  auto report = [&](double t_s) {
+    if (!progress) return;
+    progress({t_s, end_time_s, state.hinge_angle_rad.empty() ? 0.0 : state.hinge_angle_rad[0]});
+  };
+
+  // the steps exactly as RunExperiment takes them; reports (and the early-stop check) at
+  // sample steps, a whole number of samples apart
+  const double dt = options.engine.time_step_s;
+  const int64_t steps_per_sample = std::max<int64_t>(1, std::llround(options.sample_period_s / dt));
+  const int64_t samples_per_report = std::max<int64_t>(
+      1,
+      static_cast<int64_t>(std::ceil(control.progress_period_s / options.sample_period_s - 1e-9)));
+  const int64_t steps_per_report = steps_per_sample * samples_per_report;
+  for (int64_t step = 1; step <= procedure.step_count(); ++step) {
+    const double t_s = procedure.TimeAt(step);
+    procedure.RestLengthsAt(t_s, controls.rest_length_m);
+    controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
+    Step(model, options.engine, controls, state);
+    state.time_s = t_s;
+    if (!procedure.IsSampleStep(step)) continue;
+    recorder.Add(SampleState(model, state));
+    if (recorder.CanStop()) break;
+    if (step % steps_per_report != 0) continue;
+    report(t_s);
+    if (control.stop_once_decided) {
+      // settled: the target lifted while standing, or the standing check failed
+      const ExperimentResult so_far = recorder.Finish();
+      if (so_far.status == RunStatus::kDidNotStand || so_far.TargetLiftoffRad()) break;
+    }
+  }
+  ExperimentResult result = recorder.Finish();
+  result.steps = state.step_count;
+  report(state.time_s);
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------
+// options
+
+SweepOptions::SweepOptions()
+    : tension_points(PaperTensionPoints().begin(), PaperTensionPoints().end()) {}
+
+Status SweepOptions::Validate() const {
+  LIFTOFF_RETURN_IF_ERROR(base.Validate().WithContext("base"));
+  if (feet.empty()) return InvalidArgumentError("feet: expected at least one foot, got none");
+  std::set<Foot> seen_feet;
+  for (size_t f = 0; f < feet.size(); ++f) {
+    if (!seen_feet.insert(feet[f]).second) {
+      return InvalidArgumentError("feet/" + std::to_string(f) + ": foot " +
+                                  std::string(FootName(feet[f])) + " appears twice");
+    }
+  }
+  if (tension_points.empty()) {
+    return InvalidArgumentError("tension_points: expected at least one, got none");
+  }
+  std::set<std::string> seen_points;
+  for (size_t t = 0; t < tension_points.size(); ++t) {
+    const std::string where = "tension_points/" + std::to_string(t);
+    if (tension_points[t].name.empty()) {
+      return InvalidArgumentError(where + "/name: expected a non-empty name");
+    }
+    if (!seen_points.insert(tension_points[t].name).second) {
+      return InvalidArgumentError(where + "/name: \"" + tension_points[t].name +
+                                  "\" appears twice");
+    }
+  }
+  if (threads < 0 || threads > kMaxThreads) {
+    return InvalidArgumentError("threads: expected an integer in [0, " +
+                                std::to_string(kMaxThreads) + "], got " + std::to_string(threads));
+  }
+  RunControl control;
+  control.progress_period_s = progress_period_s;
+  return control.Validate();
+}
+
+// ---------------------------------------------------------------------------------------
+// results
+
+bool SweepRun::Stood() const { return result.status != RunStatus::kDidNotStand; }
+
+std::optional<double> SweepRun::LiftoffRad() const { return result.TargetLiftoffRad(); }
+
+std::string SweepRun::Brief() const { return result.Brief(); }
+
+const SweepRun* SweepResult::Find(Foot foot, std::string_view tension) const {
+  for (const SweepRun& run : runs) {
+    if (run.foot == foot && run.tension_point.name == tension) return &run;
+  }
+  return nullptr;
+}
+
+std::vector<SweepFootRange> SweepResult::Ranges() const {
+  std::vector<SweepFootRange> ranges;
+  for (Foot foot : feet) {
+    SweepFootRange range;
+    range.foot = foot;
+    for (const SweepRun& run : runs) {
+      if (run.foot != foot) continue;
+      ++range.runs;
+      const std::optional<double> value = run.LiftoffRad();
+      if (!value) continue;
+      range.min_rad = range.counted_runs == 0 ? *value : std::min(range.min_rad, *value);
+      range.max_rad = range.counted_runs == 0 ? *value : std::max(range.max_rad, *value);
+      ++range.counted_runs;
+    }
+    ranges.push_back(range);
+  }
+  return ranges;
+}
+
+std::string SweepResult::Brief() const {
+  const int stood = static_cast<int>(
+      std::count_if(runs.begin(), runs.end(), [](const SweepRun& run) { return run.Stood(); }));
+  std::ostringstream out;
+  out << model_name << ": " << Plural(static_cast<int64_t>(runs.size()), "run") << " (" << stood
+      << " stood)";
+  for (const SweepFootRange& range : Ranges()) {
+    out << ", " << FootName(range.foot) << " ";
+    if (range.counted_runs == 0) {
+      out << "-";
+    } else {
+      out << FormatFixed(range.min_rad, 3) << "-" << FormatFixed(range.max_rad, 3);
+    }
+  }
+  out << " rad, " << Plural(threads, "thread");
+  return out.str();
+}
+
+// ---------------------------------------------------------------------------------------
+// the sweep
+
+Result<SweepResult> RunSweep(const ModelDescription& description, const SweepOptions& options,
+                             const SweepProgressCallback& progress) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+
+  // every run's options, each checked against the model before any run starts
+  SweepResult sweep;
+  sweep.model_name = description.name;
+  sweep.tension_points = options.tension_points;
+  sweep.feet = options.feet;
+  std::vector<ExperimentOptions> run_options;
+  for (Foot foot : options.feet) {
+    for (size_t t = 0; t < options.tension_points.size(); ++t) {
+      ExperimentOptions run = options.base;
+      run.foot = foot;
+      run.tension_point = options.tension_points[t];
+      SweepRun& entry = sweep.runs.emplace_back();
+      entry.index = static_cast<int>(sweep.runs.size() - 1);
+      entry.foot = foot;
+      entry.tension_index = static_cast<int>(t);
+      entry.tension_point = options.tension_points[t];
+      auto model = BuildExperimentModel(description, run);
+      if (!model.ok()) return model.status().WithContext(RunName(foot, entry.tension_point));
+      run_options.push_back(std::move(run));
+    }
+  }
+  const int run_count = static_cast<int>(sweep.runs.size());
+  const int available = options.threads > 0
+                            ? options.threads
+                            : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  sweep.threads = std::min(available, run_count);
+
+  // a work queue: each worker takes the next run index; results land in their own slot,
+  // so the order and the values do not depend on the threads
+  RunControl control;
+  control.progress_period_s = options.progress_period_s;
+  control.stop_once_decided = options.stop_once_decided;
+  std::atomic<int> next_run{0};
+  std::mutex report_mutex;  // serialises progress calls and the bookkeeping below
+  int runs_done = 0;
+  std::vector<Status> failures(Index(run_count));
+  std::vector<RunProgress> last_progress(Index(run_count));
+  auto worker = [&] {
+    for (int i = next_run.fetch_add(1); i < run_count; i = next_run.fetch_add(1)) {
+      SweepRun& entry = sweep.runs[Index(i)];
+      auto on_progress = [&](const RunProgress& run_progress) {
+        std::lock_guard<std::mutex> lock(report_mutex);
+        last_progress[Index(i)] = run_progress;
+        if (!progress) return;
+        SweepProgress report;
+        report.runs_done = runs_done;
+        report.runs_total = run_count;
+        report.run_index = i;
+        report.foot = entry.foot;
+        report.tension_point = &entry.tension_point;
+        report.run = run_progress;
+        progress(report);
+      };
+      auto result =
+          RunExperimentWithProgress(description, run_options[Index(i)], control, on_progress);
+      std::lock_guard<std::mutex> lock(report_mutex);
+      ++runs_done;
+      if (!result.ok()) {
+        failures[Index(i)] = result.status().WithContext(RunName(entry.foot, entry.tension_point));
+        continue;
+      }
+      entry.result = std::move(result).value();
+      if (!progress) continue;
+      SweepProgress report;
+      report.runs_done = runs_done;
+      report.runs_total = run_count;
+      report.run_index = i;
+      report.foot = entry.foot;
+      report.tension_point = &entry.tension_point;
+      report.run = last_progress[Index(i)];
+      report.finished = &entry;
+      progress(report);
+    }
+  };
+  std::vector<std::thread> helpers;
+  for (int t = 1; t < sweep.threads; ++t) helpers.emplace_back(worker);
+  worker();
+  for (std::thread& helper : helpers) helper.join();
+
+  // the first failure in run order (the same whatever the threads)
+  for (const Status& failure : failures) {
+    if (!failure.ok()) return failure;
+  }
+  return sweep;
+}
+
+Result<TensionPoint> PaperTensionPointByName(std::string_view name) {
+  const auto& points = PaperTensionPoints();
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (name == points[i].name || name == std::to_string(i)) return points[i];
+  }
+  return InvalidArgumentError(
+      "tension point: expected low, med-low, mean, med-high, high or an index 0..4, got \"" +
+      std::string(name) + "\"");
+}
+
+}  // namespace liftoff::sim
