@@ -27,20 +27,25 @@ function(liftoff_add_module name)
   liftoff_set_warnings(liftoff_${name})
 endfunction()
 
-# liftoff_add_test(NAME SOURCES ... DEPS ... [RESOURCE_LOCK name]): one GoogleTest
-# executable per module. Tests sharing a RESOURCE_LOCK never run at the same time under
-# `ctest -j` (pseudo-terminal numbers are reused across processes).
+# liftoff_add_test(NAME SOURCES ... DEPS ... [RESOURCE_LOCK name] [FIXTURE name]):
+# one GoogleTest executable per module.
+# Tests sharing a RESOURCE_LOCK never run at the same time under `ctest -j`
+# (pseudo-terminal numbers are reused across processes); FIXTURE names a CTest fixture
+# every test of the executable requires (its setup runs once per ctest run).
 function(liftoff_add_test name)
-  cmake_parse_arguments(ARG "" "RESOURCE_LOCK" "SOURCES;DEPS" ${ARGN})
-  set(lock_property "")
+  cmake_parse_arguments(ARG "" "RESOURCE_LOCK;FIXTURE" "SOURCES;DEPS" ${ARGN})
+  set(extra_properties "")
   if(ARG_RESOURCE_LOCK)
-    set(lock_property RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+    list(APPEND extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
+  if(ARG_FIXTURE)
+    list(APPEND extra_properties FIXTURES_REQUIRED ${ARG_FIXTURE})
   endif()
   add_executable(${name}_test ${ARG_SOURCES})
   target_link_libraries(${name}_test PRIVATE ${ARG_DEPS} liftoff_test_support GTest::gtest_main GTest::gmock)
   liftoff_set_warnings(${name}_test)
   gtest_discover_tests(${name}_test
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${lock_property}
+    PROPERTIES ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${extra_properties}
     DISCOVERY_TIMEOUT 60)
 endfunction()

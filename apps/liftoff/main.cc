@@ -8,7 +8,10 @@
 
 #include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/sim_commands.h"
 #include "liftoff/cli/synth_commands.h"
+#include "liftoff/cli/video_commands.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/version.h"
 
 namespace {
@@ -48,6 +51,66 @@ void AddTestFlags(CLI::App* app, TestChoice& test) {
   app->add_option("--ramp-s", test.ramp_s, "Ramp duration, seconds")->capture_default_str();
 }
 
+void AddSimFlags(CLI::App* app, SimExperimentChoice& choice) {
+  app->add_option("--model", choice.model_path,
+                  "Model JSON (default: the bundled samples/models/laika.json)");
+  app->add_option("--pulled", choice.pulled,
+                  "Cable group the bend pulls: HR or HL (default: the foot's motion)");
+  app->add_option("--rotation", choice.rotation,
+                  "Ramp direction: + or - (write --rotation=-; default: the foot's motion)");
+  app->add_option("--bend-fraction", choice.bend_fraction,
+                  "Bend each pulled cable to this fraction of its rest length (default 0.8)");
+  app->add_option("--bend-start-s", choice.bend_start_s, "Bend start, s (default 2)");
+  app->add_option("--bend-speed", choice.bend_speed_m_per_s,
+                  "Rest-length shortening speed, m/s (default 0.025)");
+  app->add_option("--ramp-deg", choice.ramp_deg,
+                  "Final |rotation| of the ramp, degrees (default 60)");
+  app->add_option("--ramp-s", choice.ramp_s, "Ramp duration, s (default 40)");
+  app->add_option("--ramp-start-s", choice.ramp_start_s, "Ramp start, s (default 6)");
+  app->add_option("--drop-height-m", choice.drop_height_m,
+                  "Drop height above the standing pose, m (default 0.05)");
+  app->add_option("--reference-s", choice.reference_s,
+                  "Instant of the reference foot heights, s (default 5)");
+  app->add_option("--threshold-mm", choice.threshold_mm,
+                  "Liftoff: height above the reference, mm (default 1)");
+  app->add_option("--sample-period-s", choice.sample_period_s, "Sampling period, s (default 0.01)");
+  app->add_option("--ground-clearance-mm", choice.ground_clearance_mm,
+                  "Standing check: non-foot geometry this close to the ground rests on it, mm "
+                  "(default 1)");
+  app->add_option("--stop-after-rad", choice.stop_after_rad,
+                  "Stop once |rotation| is this far past the first liftoff, rad (default: never)");
+  app->add_option("--damping", choice.damping_n_s_per_m, "Cable damping, N*s/m (default 10)");
+  app->add_option("--pretension-ratios", choice.pretension_ratios,
+                  "T0/k of HT,HB,saddles,sides in m (default 0.006,0.015,0.052,0.004)");
+  app->add_option("--friction", choice.friction,
+                  "Ground friction coefficient (default: the model's)");
+  app->add_option("--spine-friction", choice.spine_friction,
+                  "Friction of the spine and hips with the ground (default: the model's)");
+  app->add_option("--marker-height-m", choice.marker_height_m,
+                  "Foot markers this far above the feet's bottoms, m (default: the model's)");
+  app->add_option("--attachment", choice.attachment,
+                  "Cable ends: node or surface (default: the model's)");
+  app->add_option("--rest-reference", choice.rest_reference,
+                  "Rest length from the attachment or node distance (default: the model's)");
+  app->add_option("--collisions", choice.collisions,
+                  "feet, ground (spine and hips with the ground too), self (spine rods with each "
+                  "other) or all (default: the model's)");
+  app->add_option("--damping-cap", choice.damping_cap,
+                  "Cap cable damping at the spring term: on or off (default: the model's)");
+  app->add_option("--dt", choice.dt_s,
+                  "Engine time step, s (default " +
+                      liftoff::FormatNumber(liftoff::sim::ExperimentOptions().engine.time_step_s) +
+                      ")");
+  app->add_flag("--implicit-stiffness", choice.implicit_stiffness,
+                "Treat cable stiffness implicitly too");
+  app->add_option("--solver-iterations", choice.solver_iterations,
+                  "Contact solver sweeps per step (default 50)");
+  app->add_option("--contact-bias", choice.contact_bias,
+                  "Fraction of a penetration removed per step (default 0.2)");
+  app->add_option("--progress", choice.progress, "Progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -69,6 +132,14 @@ int main(int argc, char** argv) {
   table_app->add_option("--tables", table.tables, "both, trials or feet")->capture_default_str();
   table_app->add_option("--sim", table.sim_path, "Simulation results JSON for the sim columns");
   table_app->add_option("--output,-o", table.output_path, "Write here instead of stdout");
+  table_app->add_option("--plot", table.plot_path,
+                        "Write the hardware-vs-simulation plot here (SVG)");
+  table_app->add_option("--verify-dir", table.verify_dir,
+                        "Write a verification image per video-analysed trial here (<id>.png)");
+  table_app
+      ->add_option("--progress", table.progress,
+                   "Video analysis progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
 
   Import2018Command import;
   CLI::App* import_app = app.add_subcommand(
@@ -192,6 +263,107 @@ int main(int argc, char** argv) {
   synth_app->add_flag("--quiet,-q", synth.quiet, "No progress lines on stderr");
   AddCalibrationFlag(synth_app, synth.calibration);
 
+  VideoCommand video;
+  CLI::App* video_app = app.add_subcommand(
+      "video", "Find the LED switch-on and the foot's liftoff in one clip, with proof");
+  video_app->add_option("clip", video.video_path, "Video file")->required();
+  video_app->add_option("--led-roi", video.led_roi,
+                        "LED region x,y,w,h in pixels (default: located automatically)");
+  video_app->add_option("--foot-roi", video.foot_roi,
+                        "Foot region x,y,w,h in pixels: the foot at rest and room above it "
+                        "(without it: the LED only)");
+  video_app->add_option("--foot", video.foot, "Track this foot's tape colour too: A, B, C or D");
+  video_app->add_option("--px-per-mm", video.px_per_mm,
+                        "Image scale at the foot, px per mm (default: from the foot's width)");
+  CLI::Option* threshold_mm =
+      video_app
+          ->add_option("--threshold-mm", video.threshold_mm, "Liftoff threshold above rest, mm")
+          ->capture_default_str();
+  video_app->add_option("--threshold-px", video.threshold_px, "Liftoff threshold above rest, px")
+      ->excludes(threshold_mm);
+  video_app->add_option("--exposure-ms", video.exposure_ms,
+                        "Camera exposure per frame, ms (default: the frame interval)");
+  video_app
+      ->add_option(
+          "--rest-window", video.rest_window,
+          "Foot rest window FROM,TO in s from the LED switch-on (write --rest-window=-1,0)")
+      ->capture_default_str();
+  video_app->add_option("--liftoff", video.liftoff, "Liftoff instant: threshold or onset")
+      ->capture_default_str();
+  video_app->add_option("--verify", video.verify_path, "Write a verification image (PNG)");
+  video_app->add_option("--annotate", video.annotate_path,
+                        "Write the clip with the detections drawn (Motion JPEG AVI)");
+  video_app->add_flag("--json", video.json, "JSON output");
+  video_app
+      ->add_option("--progress", video.progress, "Progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+
+  CLI::App* sim_app = app.add_subcommand(
+      "sim", "Simulate the foot-lifting test: one run, the tension sweep, MJCF export");
+  sim_app->require_subcommand(1);
+  SimRunCommand sim_run;
+  CLI::App* sim_run_app = sim_app->add_subcommand(
+      "run", "One simulated test: each foot's liftoff rotation, optionally the height curves");
+  sim_run_app->add_option("--foot", sim_run.foot, "Foot the test targets: A, B, C or D")
+      ->capture_default_str();
+  sim_run_app
+      ->add_option("--tension", sim_run.tension,
+                   "Tension point: low, med-low, mean, med-high, high or 0..4")
+      ->capture_default_str();
+  sim_run_app->add_option(
+      "--stiffness", sim_run.stiffness,
+      "Explicit stiffnesses SILICONE,BUNA_N,SPRING in N/m (instead of --tension)");
+  AddSimFlags(sim_run_app, sim_run.experiment);
+  sim_run_app->add_flag("--json", sim_run.json, "JSON output");
+  sim_run_app->add_option("--curves", sim_run.curves_path,
+                          "Write the foot-height curves (CSV) here; - for stdout");
+
+  SimSweepCommand sim_sweep;
+  CLI::App* sim_sweep_app = sim_app->add_subcommand(
+      "sweep",
+      "The tension points x the four foot motions in parallel (paper Table IV's sim columns)");
+  sim_sweep_app->add_option("--feet", sim_sweep.feet, "Feet, comma-separated")
+      ->capture_default_str();
+  sim_sweep_app
+      ->add_option("--tensions", sim_sweep.tensions,
+                   "Tension points, comma-separated names or 0..4, or all")
+      ->capture_default_str();
+  sim_sweep_app->add_option("--threads", sim_sweep.threads, "Worker threads (0: all cores)")
+      ->capture_default_str();
+  sim_sweep_app->add_flag("--full-ramp", sim_sweep.full_ramp,
+                          "Run every test to the end of the ramp (same values, slower)");
+  AddSimFlags(sim_sweep_app, sim_sweep.experiment);
+  sim_sweep_app->add_option("--output,-o", sim_sweep.output_path,
+                            "Write the simulation results JSON (for liftoff table --sim)");
+  sim_sweep_app->add_flag("--json", sim_sweep.json, "Print the results JSON instead of the table");
+  sim_sweep_app->add_option(
+      "--hardware", sim_sweep.hardware_path,
+      "Trial manifest or 2018 Laika folder: also print the hardware-vs-simulation table");
+  sim_sweep_app
+      ->add_option("--format,-f", sim_sweep.format, "Hardware table format: md, csv, latex or json")
+      ->capture_default_str();
+  AddCalibrationFlag(sim_sweep_app, sim_sweep.calibration);
+  AddLookupFlags(sim_sweep_app, sim_sweep.lookup);
+
+  SimExportMjcfCommand sim_export;
+  CLI::App* sim_export_app =
+      sim_app->add_subcommand("export-mjcf", "Write the model as a MuJoCo MJCF file");
+  sim_export_app->add_option("--output,-o", sim_export.output_path, "MJCF file; - for stdout")
+      ->required();
+  sim_export_app->add_option("--foot", sim_export.foot, "The experiment's model for this foot")
+      ->capture_default_str();
+  sim_export_app->add_option("--tension", sim_export.tension, "... at this tension point")
+      ->capture_default_str();
+  sim_export_app->add_flag("--as-is", sim_export.as_is,
+                           "Export the model file as written (no tension point applied)");
+  sim_export_app
+      ->add_option("--hinge-drive", sim_export.hinge_drive,
+                   "equality (set by a runner each step) or actuator (a position servo)")
+      ->capture_default_str();
+  sim_export_app->add_option("--lift-m", sim_export.lift_m, "Raise the free bodies by this, m")
+      ->capture_default_str();
+  AddSimFlags(sim_export_app, sim_export.experiment);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -210,6 +382,10 @@ int main(int argc, char** argv) {
     if (*ports_app) return RunPorts(ports, std::cout, std::cerr);
     if (*journal_app) return RunJournal(journal, std::cout, std::cerr);
     if (*synth_app) return RunSynth(synth, std::cout, std::cerr);
+    if (*video_app) return RunVideo(video, std::cout, std::cerr);
+    if (*sim_run_app) return RunSimRun(sim_run, std::cout, std::cerr);
+    if (*sim_sweep_app) return RunSimSweep(sim_sweep, std::cout, std::cerr);
+    if (*sim_export_app) return RunSimExportMjcf(sim_export, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "liftoff: internal error: " << error.what() << '\n';
     return kExitInternal;

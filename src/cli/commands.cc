@@ -9,10 +9,12 @@
 
 #include "cli_common.h"
 #include "liftoff/capture/laika2018.h"
+#include "liftoff/cli/video_commands.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "liftoff/stats/plot.h"
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
 #include "liftoff/sync/trial_analysis.h"
@@ -67,6 +69,8 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto lookup = LookupOptionsFrom(command.lookup);
   if (!lookup.ok()) return ReportError(lookup.status(), err);
+  auto progress = VideoProgress::Create(command.progress, err);
+  if (!progress.ok()) return ReportError(progress.status(), err);
 
   // inputs: manifest (or a 2018 folder read as one), calibration, optional sim results
   auto manifest = LoadTrials(command.manifest_path, err);
@@ -81,14 +85,25 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
     sim = std::move(loaded).value();
   }
 
-  // every trial through sync; failures are reported and the rest still tabulated
+  // every trial through sync (videos without times through video analysis); failures are
+  // reported and the rest still tabulated
   sync::AnalysisOptions options;
   options.lookup = *lookup;
   options.log.max_bad_lines = command.lookup.max_bad_lines;
+  options.video_progress = [&](const TrialRecord& trial, int64_t frames_done, int64_t t_ns) {
+    progress->Show(trial.id, frames_done, t_ns);
+  };
   const sync::ManifestAnalysis analysis = sync::AnalyzeManifest(*manifest, *calibration, options);
+  progress->Done();
   Status first_failure;
   for (const sync::TrialOutcome& outcome : analysis.outcomes) {
     PrintLogWarnings(outcome.log_report, err);
+    if (outcome.video) {
+      err << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
+      for (const std::string& warning : outcome.video->warnings) {
+        err << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
+      }
+    }
     if (!outcome.status.ok()) {
       err << "error: " << outcome.status.ToString() << '\n';
       if (first_failure.ok()) first_failure = outcome.status;
@@ -115,13 +130,22 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   }
   const int emitted = Emit(text, command.output_path, out, err);
   if (emitted != kExitOk) return emitted;
+  Status verified;
+  if (!command.verify_dir.empty()) {
+    verified = WriteTrialVerifications(analysis, command.verify_dir, err);
+  }
+  if (!command.plot_path.empty() && verified.ok()) {
+    auto plot = stats::RenderResultsPlotSvg(table);
+    verified = plot.ok() ? WriteFileAtomically(command.plot_path, *plot) : plot.status();
+    if (verified.ok()) err << "wrote " << command.plot_path.string() << '\n';
+  }
 
   if (!first_failure.ok()) {
     err << "liftoff: " << analysis.failed() << " of " << analysis.outcomes.size()
         << " trials failed; the table holds the others\n";
     return ExitCodeFor(first_failure.code());
   }
-  return kExitOk;
+  return verified.ok() ? kExitOk : ExitCodeFor(verified.code());
 }
 
 // ---------------------------------------------------------------------------------------

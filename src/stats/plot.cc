@@ -85,9 +85,8 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
   };
 
   std::ostringstream svg;
-  svg << R"(<svg xmlns="http://www.w3.org/2000/svg" width=")" << options.width_px
-      << R"(" height=")" << options.height_px << R"(" font-family="sans-serif" font-size="12">)"
-      << '\n';
+  svg << R"(<svg xmlns="http://www.w3.org/2000/svg" width=")" << options.width_px << R"(" height=")"
+      << options.height_px << R"(" font-family="sans-serif" font-size="12">)" << '\n';
   svg << R"(<rect width="100%" height="100%" fill="white"/>)" << '\n';
   svg << R"(<text x=")" << Px(options.width_px / 2.0) << R"(" y="24" text-anchor="middle" )"
       << R"(font-size="15" font-weight="bold">)"
@@ -101,8 +100,8 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
     const double y = y_of(rad);
     svg << R"(<line x1=")" << Px(left) << R"(" x2=")" << Px(right) << R"(" y1=")" << Px(y)
         << R"(" y2=")" << Px(y) << R"(" stroke="#ddd"/>)" << '\n';
-    svg << R"(<text x=")" << Px(left - 8) << R"(" y=")" << Px(y + 4)
-        << R"(" text-anchor="end">)" << FormatFixed(rad, 2) << "</text>\n";
+    svg << R"(<text x=")" << Px(left - 8) << R"(" y=")" << Px(y + 4) << R"(" text-anchor="end">)"
+        << FormatFixed(rad, 2) << "</text>\n";
   }
   svg << R"(<text transform="translate(18 )" << Px((top + bottom) / 2)
       << R"svg() rotate(-90)" text-anchor="middle">liftoff rotation (rad)</text>)svg" << '\n';
@@ -158,9 +157,8 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
       }
       svg << R"(<line x1=")" << Px(x - 7) << R"(" x2=")" << Px(x + 7) << R"(" y1=")"
           << Px(y_of(hw.mean)) << R"(" y2=")" << Px(y_of(hw.mean))
-          << R"(" stroke="black" stroke-width="2"><title>hardware mean )" << FootName(foot)
-          << ": " << FormatFixed(hw.mean, 3) << " rad (n " << hw.n
-          << ")</title></line>\n";
+          << R"(" stroke="black" stroke-width="2"><title>hardware mean )" << FootName(foot) << ": "
+          << FormatFixed(hw.mean, 3) << " rad (n " << hw.n << ")</title></line>\n";
     }
   }
 

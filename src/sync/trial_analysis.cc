@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "liftoff/capture/log_loader.h"
+#include "liftoff/core/text.h"
 
 namespace liftoff::sync {
 namespace {
@@ -12,18 +13,45 @@ Status ForTrial(const Status& status, const TrialRecord& trial) {
   return status.WithContext(trial.id);
 }
 
+// the trial's video through video analysis, with the trial's regions, foot and scale
+Result<video::ClipAnalysis> AnalyzeTrialVideo(const TrialRecord& trial,
+                                              const AnalysisOptions& options) {
+  const std::filesystem::path& video_path = *trial.video_path;
+  if (!trial.foot_roi_px) {
+    return InvalidArgumentError(video_path.string() +
+                                ": the trial has a video but no foot region (roi.foot_px) to "
+                                "find its liftoff in; give one, or hand times");
+  }
+  video::ClipAnalysisOptions clip = options.video;
+  if (trial.led_roi_px) clip.led.roi_px = video::RectFromRegion(*trial.led_roi_px);
+  clip.foot.foot_roi_px = video::RectFromRegion(*trial.foot_roi_px);
+  if (options.use_tape_colour) clip.foot.tape_colour = trial.foot;
+  if (trial.px_per_mm) clip.foot.px_per_mm = *trial.px_per_mm;
+  video::ClipProgress progress;
+  if (options.video_progress) {
+    progress = [&](int64_t frames_done, int64_t t_ns) {
+      options.video_progress(trial, frames_done, t_ns);
+    };
+  }
+  return video::AnalyzeClip(video_path, clip, progress);
+}
+
 // one trial, start to end
 Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibration,
                     const AnalysisOptions& options, TrialOutcome& outcome) {
   const TrialRecord& trial = outcome.trial;
-  // hand times are the only source of event times for now
-  if (!trial.times) {
-    if (trial.video_path) {
-      return ForTrial(UnsupportedError(trial.video_path->string() +
-                                       ": automatic video analysis is not available yet; "
-                                       "give hand times"),
-                      trial);
-    }
+  // hand times, else the video's
+  EventTimes times;
+  if (trial.times) {
+    times = *trial.times;
+  } else if (trial.video_path) {
+    Result<video::ClipAnalysis> clip = AnalyzeTrialVideo(trial, options);
+    if (!clip.ok()) return ForTrial(clip.status(), trial);
+    outcome.video = std::move(clip).value();
+    Result<EventTimes> found = outcome.video->Events();
+    if (!found.ok()) return ForTrial(found.status(), trial);
+    times = *found;
+  } else {
     const std::string manifest_name =
         manifest.source_path.empty() ? "manifest" : manifest.source_path.string();
     return ForTrial(
@@ -37,7 +65,7 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
       capture::LoadControllerLog(trial.log_path, trial.log_format, calibration, options.log);
   if (!log.ok()) return ForTrial(log.status(), trial);
   outcome.log_report = log->report;
-  Result<LiftoffMeasurement> measurement = MeasureLiftoff(*log, *trial.times, options.lookup);
+  Result<LiftoffMeasurement> measurement = MeasureLiftoff(*log, times, options.lookup);
   if (!measurement.ok()) {
     return ForTrial(measurement.status().WithContext(trial.log_path.string()), trial);
   }
@@ -49,7 +77,8 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
 
 Status AnalysisOptions::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(lookup.Validate());
-  return log.Validate();
+  LIFTOFF_RETURN_IF_ERROR(log.Validate());
+  return video.Validate().WithContext("video");
 }
 
 int64_t ManifestAnalysis::failed() const {
@@ -74,6 +103,9 @@ std::vector<stats::TrialValue> ManifestAnalysis::Values() const {
     }
     if (lookup.before_start && lookup.sample_after_ns) {
       add("before start " + FormatSeconds(*lookup.sample_after_ns - lookup.query_ns) + " s");
+    }
+    if (outcome.video && !outcome.video->warnings.empty()) {
+      add("video: " + Plural(static_cast<int64_t>(outcome.video->warnings.size()), "warning"));
     }
     stats::TrialValue value;
     value.trial_id = outcome.trial.id;

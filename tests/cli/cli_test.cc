@@ -232,6 +232,25 @@ TEST(CliTable, SimulationResultsFillTheSimColumns) {
   EXPECT_THAT(bad.err, HasSubstr("sim.json: /summary"));
 }
 
+TEST(CliTable, PlotShowsTheTrialAndTheSimulatedBand) {
+  ScratchDir scratch;
+  const nlohmann::json sim = {{"format", "liftoff-sim-results"},
+                              {"version", 1},
+                              {"model", "test"},
+                              {"summary", {{"A", {{"min_rad", 0.123}, {"max_rad", 0.456}}}}}};
+  WriteFile(scratch / "sim.json", sim.dump());
+  TableCommand command;
+  command.manifest_path = WriteOneTrial(scratch, RampLog2018(5000), 1.0, 3.0);
+  command.sim_path = scratch / "sim.json";
+  command.plot_path = scratch / "plot.svg";
+  const CommandRun run = RunTableCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  const std::string svg = ReadFile(scratch / "plot.svg");
+  EXPECT_THAT(svg, HasSubstr(": 0.500 rad</title></circle>"));  // the one trial
+  EXPECT_THAT(svg, HasSubstr("sim A: 0.123 .. 0.456 rad"));
+  EXPECT_THAT(svg, HasSubstr("calibration: "));
+}
+
 TEST(CliTable, AFolderThatIsNotA2018FolderIsRejected) {
   ScratchDir scratch;
   TableCommand command;

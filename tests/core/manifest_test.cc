@@ -428,8 +428,9 @@ TEST(Manifest, PixelScaleIsReadCheckedAndWrittenBack) {
   testing::WriteFile(dir / "bad.json", bad);
   const Result<TrialManifest> rejected = LoadManifest(dir / "bad.json");
   ASSERT_FALSE(rejected.ok());
-  EXPECT_THAT(rejected.status().message(),
-              ::testing::HasSubstr("/trials/0/video/px_per_mm: expected a number in (0, 1000], got 0"));
+  EXPECT_THAT(
+      rejected.status().message(),
+      ::testing::HasSubstr("/trials/0/video/px_per_mm: expected a number in (0, 1000], got 0"));
 }
 
 }  // namespace

@@ -36,8 +36,8 @@ double ExpectedY(double rad) { return 350.0 - (rad - 0.2) / 0.4 * 300.0; }
 std::vector<double> CircleRows(const std::string& svg) {
   std::vector<double> rows;
   const std::regex circle(R"re(<circle cx="[0-9.]+" cy="([0-9.]+)")re");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), circle);
-       it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), circle); it != std::sregex_iterator();
+       ++it) {
     rows.push_back(std::stod((*it)[1]));
   }
   return rows;

@@ -129,18 +129,66 @@ TEST(AnalyzeManifest, TrialsWithoutTimesFailWithTheirReason) {
       AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
   ASSERT_EQ(analysis.outcomes.size(), 3u);
   EXPECT_EQ(analysis.failed(), 2);
+  // a video without a foot region cannot be analysed
   const Status& video_only = analysis.outcomes[0].status;
-  EXPECT_EQ(video_only.code(), StatusCode::kUnsupported);
+  EXPECT_EQ(video_only.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(video_only.message(), StartsWith("A1: "));
   EXPECT_THAT(video_only.message(), HasSubstr("A1.mp4"));
-  EXPECT_THAT(video_only.message(),
-              HasSubstr("automatic video analysis is not available yet; give hand times"));
+  EXPECT_THAT(video_only.message(), HasSubstr("no foot region (roi.foot_px)"));
+  EXPECT_FALSE(analysis.outcomes[0].video.has_value());
   const Status& nothing = analysis.outcomes[1].status;
   EXPECT_EQ(nothing.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(nothing.message(), StartsWith("A2: "));
   EXPECT_THAT(nothing.message(), HasSubstr("trials.json"));
   EXPECT_TRUE(analysis.outcomes[2].status.ok());
   EXPECT_NEAR(analysis.outcomes[2].measurement->liftoff_rad, 0.35, 1e-12);
+}
+
+// (Video analysis that succeeds, end to end through sync on rendered clips, is tested in
+// tests/video/ci_set_test.cc: this test binary has no renderer.)
+TEST(AnalyzeManifest, TrialsWithAVideoAndNoTimesGoThroughVideoAnalysis) {
+  ScratchDir scratch;
+  WriteFile(scratch / "good.txt", RampLog());
+  WriteFile(scratch / "notes.mp4", "not a video\n");
+  TrialManifest manifest;
+  const auto video_trial = [&](std::string id, std::filesystem::path video) {
+    manifest.trials.push_back(Trial(std::move(id), Foot::kB, scratch / "good.txt"));
+    manifest.trials.back().video_path = std::move(video);
+    manifest.trials.back().foot_roi_px = RegionPx{10, 10, 30, 40};
+  };
+  video_trial("B1", scratch / "absent.mp4");
+  video_trial("B2", scratch / "notes.mp4");
+  // hand times win over the video: its file is never opened
+  video_trial("B3", scratch / "absent.mp4");
+  manifest.trials.back().times = HandTimes(0, 700);
+
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), Hold());
+  ASSERT_EQ(analysis.outcomes.size(), 3u);
+  EXPECT_EQ(analysis.outcomes[0].status.code(), StatusCode::kNotFound);
+  EXPECT_THAT(analysis.outcomes[0].status.message(), StartsWith("B1: "));
+  EXPECT_THAT(analysis.outcomes[0].status.message(), HasSubstr("absent.mp4"));
+  EXPECT_EQ(analysis.outcomes[1].status.code(), StatusCode::kParse);
+  EXPECT_THAT(analysis.outcomes[1].status.message(), StartsWith("B2: "));
+  EXPECT_THAT(analysis.outcomes[1].status.message(), HasSubstr("not a video"));
+  ASSERT_TRUE(analysis.outcomes[2].status.ok()) << analysis.outcomes[2].status.ToString();
+  EXPECT_FALSE(analysis.outcomes[2].video.has_value());
+  EXPECT_NEAR(analysis.outcomes[2].measurement->liftoff_rad, 0.35, 1e-12);
+}
+
+TEST(AnalyzeManifest, InvalidVideoOptionsFailEveryTrial) {
+  ScratchDir scratch;
+  WriteFile(scratch / "good.txt", RampLog());
+  TrialManifest manifest;
+  manifest.trials.push_back(Trial("A1", Foot::kA, scratch / "good.txt"));
+  manifest.trials.back().times = HandTimes(0, 500);
+  AnalysisOptions options;
+  options.video.rest_min_frames = 0;
+  EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
+  const ManifestAnalysis analysis =
+      AnalyzeManifest(manifest, liftoff::testing::DriveChainCalibration(), options);
+  EXPECT_EQ(analysis.failed(), 1);
+  EXPECT_THAT(analysis.outcomes[0].status.message(), StartsWith("A1: video: rest_min_frames"));
 }
 
 TEST(AnalyzeManifest, LookupErrorsNameTheTrialAndTheLog) {

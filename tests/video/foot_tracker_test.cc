@@ -1,1 +1,464 @@
-// placeholder: being written
+#include "liftoff/video/foot_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "liftoff/synth/scene.h"
+#include "liftoff/synth/spec.h"
+#include "liftoff/synth/trial_writer.h"
+#include "support/test_support.h"
+
+namespace liftoff::video {
+namespace {
+
+// 640 x 480 at 60 fps, exposure 1/120 s (the CI baseline's camera, scale 0.69 px/mm), foot A
+// (blue): LED at 0.2 s, a 0.2 rad/s ramp from 0.2 s after it, liftoff at 0.25 rad, so the
+// foot leaves the ground at 1.65 s and is 1 mm up 0.126 s later; 2.2 s, 132 frames.
+synth::TrialSpec BaseSpec() {
+  synth::TrialSpec spec;
+  spec.id = "foot-tracker";
+  spec.seed = 11;
+  spec.duration_s = 2.2;
+  spec.camera.width_px = 640;
+  spec.camera.height_px = 480;
+  spec.camera.fps = 60;
+  spec.camera.exposure_s = 1.0 / 120;
+  spec.led.on_video_s = 0.2;
+  spec.motion.foot = Foot::kA;
+  spec.motion.bend_start_s = 0;
+  spec.motion.bend_end_s = 0.1;
+  spec.motion.ramp_start_s = 0.2;
+  spec.motion.ramp_rate_rad_per_s = 0.2;
+  spec.motion.height.liftoff_rad = 0.25;
+  return spec;
+}
+
+struct Scene {
+  synth::Timeline timeline;
+  synth::SceneRenderer renderer;
+  int64_t exposure_ns = 0;
+  int64_t frame_ns = 0;
+
+  // The truth a frame starting at t_ns shows: the foot's rise at mid-exposure, px.
+  double TrueRisePx(int64_t t_ns) const {
+    return renderer.foot_rest_bottom_px() - renderer.FootBottomPxAt(t_ns + exposure_ns / 2);
+  }
+  cv::Rect FootRoi() const {
+    const RegionPx roi = renderer.foot_roi_px();
+    return {roi.x_px, roi.y_px, roi.width_px, roi.height_px};
+  }
+};
+
+Scene MakeScene(const synth::TrialSpec& spec) {
+  Result<synth::Timeline> timeline = synth::Timeline::Create(spec);
+  EXPECT_TRUE(timeline.ok()) << timeline.status().ToString();
+  Result<synth::SceneRenderer> renderer = synth::SceneRenderer::Create(*timeline);
+  EXPECT_TRUE(renderer.ok()) << renderer.status().ToString();
+  return {*timeline, std::move(*renderer), synth::ExposureNs(spec.camera),
+          static_cast<int64_t>(std::llround(1e9 / spec.camera.fps))};
+}
+
+// Options for a scene: its foot region, its true scale, the rest window LED .. LED + 0.2 s.
+FootTracker::Options OptionsFor(const Scene& scene) {
+  FootTracker::Options options;
+  options.foot_roi_px = scene.FootRoi();
+  options.px_per_mm = scene.renderer.px_per_mm();
+  options.rest_from_ns = *scene.timeline.LedOnVideoNs();
+  options.rest_to_ns = options.rest_from_ns + 200'000'000;
+  return options;
+}
+
+// Feeds every frame of the clip, rendered in memory (exact pixels), optionally changed by
+// `edit`, and returns the result.
+Result<FootTrack> TrackClip(Scene& scene, const FootTracker::Options& options,
+                            const std::function<void(cv::Mat&)>& edit = {}) {
+  FootTracker tracker(options);
+  const int64_t count = scene.timeline.duration_ns() / scene.frame_ns;
+  for (int64_t k = 0; k < count; ++k) {
+    Frame frame;
+    frame.index = k;
+    frame.t_ns = k * scene.frame_ns;
+    frame.bgr = scene.renderer.RenderFrame(k, frame.t_ns);
+    if (edit) edit(frame.bgr);
+    const Status status = tracker.Process(frame);
+    if (!status.ok()) return status;
+  }
+  return tracker.Finish();
+}
+
+int64_t TruthNsAboveMm(const Scene& scene, double height_mm) {
+  const std::optional<int64_t> t_ns = scene.timeline.FirstVideoNsAbove(height_mm / 1000);
+  EXPECT_TRUE(t_ns.has_value());
+  return t_ns.value_or(0);
+}
+
+// The 2018 drive chain and a spool, enough to write a trial's log.
+Calibration TestCalibration() {
+  Calibration calibration = liftoff::testing::DriveChainCalibration();
+  calibration.spool_groove_radii_m = {0.004, 0.004, 0.008, 0.012};
+  calibration.cable_lengths_m = {0.088, 0.088, 0.088, 0.088};
+  return calibration;
+}
+
+// ---------------------------------------------------------------------------------------
+// the height curve
+
+TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
+  synth::TrialSpec spec = BaseSpec();
+  spec.duration_s = 3.0;  // the foot 35 mm (24 px) up at the end
+  Scene scene = MakeScene(spec);
+  FootTracker::Options options = OptionsFor(scene);
+  options.rest_from_ns = options.rest_to_ns = 0;  // the first frames
+  options.rest_frames = 3;
+  FootTracker tracker(options);
+  // three frames at rest, then frames whose mid-exposure shows the foot at these heights
+  std::vector<double> heights_px = {0,   0,   0,   0.05, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9,
+                                    1.0, 1.3, 1.7, 2.0,  2.5, 3.0,  4.5, 6.0, 9.0, 13.0, 18.0};
+  const double px_per_mm = scene.renderer.px_per_mm();
+  std::vector<int64_t> times_ns;
+  for (size_t i = 0; i < heights_px.size(); ++i) {
+    int64_t t_ns = static_cast<int64_t>(i) * scene.frame_ns;
+    if (heights_px[i] > 0) {
+      t_ns = TruthNsAboveMm(scene, heights_px[i] / px_per_mm) - scene.exposure_ns / 2;
+    }
+    times_ns.push_back(t_ns);
+    Frame frame{static_cast<int64_t>(i), t_ns, false,
+                scene.renderer.RenderFrame(static_cast<int64_t>(i), t_ns)};
+    ASSERT_TRUE(tracker.Process(frame).ok());
+  }
+  Result<FootTrack> track = tracker.Finish();
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  ASSERT_EQ(track->samples.size(), heights_px.size());
+  for (size_t i = 0; i < heights_px.size(); ++i) {
+    const double truth_px = scene.TrueRisePx(times_ns[i]);
+    EXPECT_NEAR(track->samples[i].rise_px, truth_px, 0.02) << "at " << heights_px[i] << " px";
+    EXPECT_GT(track->samples[i].quality, 0.95);
+  }
+  // the foot as located: its bottom edge and width against the renderer's placement
+  const auto& place = scene.renderer.placement(Foot::kA);
+  EXPECT_NEAR(track->foot_bottom_px, place.bottom_px, 0.5);
+  EXPECT_NEAR(track->foot_center_x_px, place.center_x_px, 0.5);
+  EXPECT_NEAR(track->foot_width_px, place.width_px, 0.5);
+  EXPECT_LT(track->template_last_row, place.bottom_px);  // never the ground below the foot
+}
+
+TEST(FootTracker, CameraShakeIsMeasuredAndRemoved) {
+  synth::TrialSpec spec = BaseSpec();
+  spec.nuisance.shake_px = 1.0;
+  Scene scene = MakeScene(spec);
+  Result<FootTrack> track = TrackClip(scene, OptionsFor(scene));
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  EXPECT_FALSE(track->reference_patches_px.empty());
+  const double first_shake_y = scene.renderer.ShakeOffsetPx(0).y;
+  double shake_span = 0, sum_sq = 0, worst = 0;
+  for (const HeightSample& sample : track->samples) {
+    const double true_shake = scene.renderer.ShakeOffsetPx(sample.frame_index).y - first_shake_y;
+    shake_span = std::max(shake_span, std::abs(true_shake));
+    EXPECT_NEAR(sample.shake_y_px, true_shake, 0.25) << "frame " << sample.frame_index;
+    const double error = sample.rise_px - scene.TrueRisePx(sample.t_ns);
+    sum_sq += error * error;
+    worst = std::max(worst, std::abs(error));
+  }
+  EXPECT_GT(shake_span, 2.0);  // the shake is far larger than the threshold ...
+  EXPECT_LT(std::sqrt(sum_sq / static_cast<double>(track->samples.size())), 0.05);  // ... gone
+  EXPECT_LT(worst, 0.25);
+  const int64_t truth_ns = TruthNsAboveMm(scene, 1.0);
+  EXPECT_NEAR(static_cast<double>(track->above_threshold.t_ns), static_cast<double>(truth_ns),
+              0.5 * static_cast<double>(scene.frame_ns));
+
+  // a reference region given by hand (here: the first one chosen) is used as given
+  FootTracker::Options by_hand = OptionsFor(scene);
+  by_hand.reference_roi_px = track->reference_patches_px.front();
+  Result<FootTrack> given = TrackClip(scene, by_hand);
+  ASSERT_TRUE(given.ok()) << given.status().ToString();
+  ASSERT_EQ(given->reference_patches_px.size(), 1u);
+  EXPECT_EQ(given->reference_roi_px, by_hand.reference_roi_px);
+  EXPECT_NEAR(static_cast<double>(given->above_threshold.t_ns), static_cast<double>(truth_ns),
+              0.5 * static_cast<double>(scene.frame_ns));
+}
+
+TEST(FootTracker, ShadowChangeAloneIsNotALift) {
+  // the same scene with and without shadows, the foot at rest: the frames fade from one to
+  // the other, so only the shadows change (under the foot too)
+  synth::TrialSpec spec = BaseSpec();
+  spec.duration_s = 1.0;
+  Scene shaded = MakeScene(spec);
+  spec.nuisance.shadow = false;
+  Scene bare = MakeScene(spec);
+  const cv::Mat with_shadow = shaded.renderer.RenderFrame(0, 0).clone();
+  const cv::Mat without_shadow = bare.renderer.RenderFrame(0, 0).clone();
+  ASSERT_GT(cv::norm(with_shadow, without_shadow, cv::NORM_INF), 40);
+
+  // at 1 mm, and even at a twentieth of a pixel
+  for (const double threshold_px : {0.0, 0.05}) {
+    FootTracker::Options options = OptionsFor(shaded);
+    options.threshold_px = threshold_px;
+    FootTracker tracker(options);
+    for (int64_t k = 0; k < 60; ++k) {
+      const double fade = std::clamp((static_cast<double>(k) - 20) / 30, 0.0, 1.0);
+      Frame frame;
+      frame.index = k;
+      frame.t_ns = k * shaded.frame_ns;
+      cv::addWeighted(with_shadow, 1 - fade, without_shadow, fade, 0, frame.bgr);
+      ASSERT_TRUE(tracker.Process(frame).ok());
+    }
+    Result<FootTrack> track = tracker.Finish();
+    ASSERT_FALSE(track.ok()) << track->Brief();
+    EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
+    EXPECT_NE(track.status().message().find("the foot never lifts"), std::string::npos)
+        << track.status().message();
+    EXPECT_NE(track.status().message().find("largest rise"), std::string::npos);
+  }
+}
+
+TEST(FootTracker, FootThatNeverLiftsIsNotFound) {
+  synth::TrialSpec spec = BaseSpec();
+  spec.motion.ramp_rate_rad_per_s = 0.05;  // 0.05 rad by the end: far from 0.25
+  Scene scene = MakeScene(spec);
+  Result<FootTrack> track = TrackClip(scene, OptionsFor(scene));
+  ASSERT_FALSE(track.ok());
+  EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
+  EXPECT_NE(track.status().message().find("the foot never lifts"), std::string::npos)
+      << track.status().message();
+}
+
+// ---------------------------------------------------------------------------------------
+// the instants
+
+TEST(FootTracker, ThresholdInstantIsWithinAFractionOfAFrameOfTruth) {
+  Scene scene = MakeScene(BaseSpec());
+  Result<FootTrack> track = TrackClip(scene, OptionsFor(scene));
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  const int64_t truth_ns = TruthNsAboveMm(scene, 1.0);
+  const int64_t error_ns = track->above_threshold.t_ns - truth_ns;
+  EXPECT_LT(std::abs(error_ns), scene.frame_ns / 4) << track->Brief();
+  EXPECT_LE(std::abs(error_ns), track->above_threshold.uncertainty_ns);
+  EXPECT_LT(track->above_threshold.uncertainty_ns, scene.frame_ns);
+  // the frames either side of the instant bracket the truth (frame k starts at k / 60 s)
+  EXPECT_LE(track->above_threshold.frame_before * scene.frame_ns + scene.exposure_ns / 2, truth_ns);
+  EXPECT_GE(track->above_threshold.frame_after * scene.frame_ns + scene.exposure_ns / 2, truth_ns);
+  EXPECT_NEAR(track->threshold_px, scene.renderer.px_per_mm(), 1e-9);
+  EXPECT_NEAR(track->rest_rise_px, 0.0, 0.01);
+  // the onset: the knee of the curve, where the foot leaves the ground
+  const int64_t leaves_ns = *scene.timeline.FirstVideoNsAbove(0.0);
+  EXPECT_LE(std::abs(track->onset.t_ns - leaves_ns), track->onset.uncertainty_ns) << track->Brief();
+  EXPECT_LT(std::abs(track->onset.t_ns - leaves_ns), 3 * scene.frame_ns);
+  EXPECT_LT(track->onset.t_ns, track->above_threshold.t_ns);
+}
+
+TEST(FootTracker, KnownExposureDatesFramesAtMidExposure) {
+  // 30 fps with a full-frame exposure: frames show the foot 16.7 ms after they start
+  synth::TrialSpec spec = BaseSpec();
+  spec.camera.fps = 30;
+  spec.camera.exposure_s = 1.0 / 30;
+  Scene scene = MakeScene(spec);
+  FootTracker::Options options = OptionsFor(scene);
+  options.exposure_s = spec.camera.exposure_s;
+  Result<FootTrack> track = TrackClip(scene, options);
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  EXPECT_NEAR(static_cast<double>(track->exposure_offset_ns),
+              0.5 * static_cast<double>(scene.exposure_ns), 1.0);
+  const int64_t truth_ns = TruthNsAboveMm(scene, 1.0);
+  EXPECT_LT(std::abs(track->above_threshold.t_ns - truth_ns), scene.frame_ns / 4) << track->Brief();
+}
+
+TEST(FootTracker, ThresholdInPixelsOrInMillimetres) {
+  Scene scene = MakeScene(BaseSpec());
+  const double px_per_mm = scene.renderer.px_per_mm();
+
+  FootTracker::Options in_px = OptionsFor(scene);
+  in_px.threshold_px = 2.0;  // ignores threshold_mm
+  Result<FootTrack> by_px = TrackClip(scene, in_px);
+  ASSERT_TRUE(by_px.ok()) << by_px.status().ToString();
+  EXPECT_DOUBLE_EQ(by_px->threshold_px, 2.0);
+  EXPECT_LT(std::abs(by_px->above_threshold.t_ns - TruthNsAboveMm(scene, 2.0 / px_per_mm)),
+            scene.frame_ns / 4);
+
+  FootTracker::Options in_mm = OptionsFor(scene);
+  in_mm.threshold_mm = 3.0;
+  Result<FootTrack> by_mm = TrackClip(scene, in_mm);
+  ASSERT_TRUE(by_mm.ok()) << by_mm.status().ToString();
+  EXPECT_NEAR(by_mm->threshold_px, 3.0 * px_per_mm, 1e-9);
+  EXPECT_LT(std::abs(by_mm->above_threshold.t_ns - TruthNsAboveMm(scene, 3.0)), scene.frame_ns / 4);
+  EXPECT_GT(by_mm->above_threshold.t_ns, by_px->above_threshold.t_ns);  // 2 px < 3 mm
+}
+
+TEST(FootTracker, EstimatesTheScaleFromTheFootWidth) {
+  for (const int width_px : {640, 1280}) {
+    synth::TrialSpec spec = BaseSpec();
+    spec.camera.width_px = width_px;
+    spec.camera.height_px = width_px * 9 / 16;
+    // a fast ramp: a short clip at 720p
+    spec.duration_s = 0.8;
+    spec.motion.height.liftoff_rad = 0.1;
+    spec.motion.ramp_rate_rad_per_s = 0.5;
+    Scene scene = MakeScene(spec);
+    for (const bool tape : {false, true}) {
+      FootTracker::Options options = OptionsFor(scene);
+      options.px_per_mm = 0;
+      if (tape) options.tape_colour = Foot::kA;
+      Result<FootTrack> track = TrackClip(scene, options);
+      ASSERT_TRUE(track.ok()) << track.status().ToString();
+      EXPECT_TRUE(track->px_per_mm_estimated);
+      EXPECT_NEAR(track->px_per_mm / scene.renderer.px_per_mm(), 1.0, 0.02)
+          << width_px << " px wide, tape " << tape;
+      EXPECT_EQ(track->located_by_tape, tape);
+      EXPECT_NE(track->Brief().find("scale estimated"), std::string::npos) << track->Brief();
+    }
+  }
+}
+
+TEST(FootTracker, TapeColourLocatesAFootOffCentreInAWideRegion) {
+  Scene scene = MakeScene(BaseSpec());
+  FootTracker::Options options = OptionsFor(scene);
+  // a region three feet wide with the foot at its right end: its centre is not the foot's
+  const double foot_width_px = scene.renderer.placement(Foot::kA).width_px;
+  const int extra = static_cast<int>(std::lround(2 * foot_width_px));
+  options.foot_roi_px.x -= extra;
+  options.foot_roi_px.width += extra;
+  options.tape_colour = Foot::kA;
+  Result<FootTrack> track = TrackClip(scene, options);
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  EXPECT_TRUE(track->located_by_tape);
+  EXPECT_NEAR(track->foot_center_x_px, scene.renderer.placement(Foot::kA).center_x_px, 0.5);
+  EXPECT_LT(std::abs(track->above_threshold.t_ns - TruthNsAboveMm(scene, 1.0)), scene.frame_ns / 4);
+
+  // another foot's colour is not there: said, and the foot located by brightness instead
+  options.foot_roi_px = scene.FootRoi();
+  options.tape_colour = Foot::kB;
+  Result<FootTrack> wrong = TrackClip(scene, options);
+  ASSERT_TRUE(wrong.ok()) << wrong.status().ToString();
+  EXPECT_FALSE(wrong->located_by_tape);
+  ASSERT_FALSE(wrong->warnings.empty());
+  EXPECT_NE(wrong->warnings[0].find("not found"), std::string::npos) << wrong->warnings[0];
+}
+
+TEST(FootTracker, NoiseFlickerAndMotionBlurKeepTheInstantWithinHalfAFrame) {
+  synth::TrialSpec spec = BaseSpec();
+  spec.nuisance.noise_sigma = 4;
+  spec.nuisance.flicker_amplitude = 0.2;
+  spec.nuisance.flicker_hz = 100;
+  spec.nuisance.motion_blur_samples = 4;
+  Scene scene = MakeScene(spec);
+  Result<FootTrack> track = TrackClip(scene, OptionsFor(scene));
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  EXPECT_LT(track->rest_noise_px, 0.05);
+  EXPECT_LT(std::abs(track->above_threshold.t_ns - TruthNsAboveMm(scene, 1.0)), scene.frame_ns / 2)
+      << track->Brief();
+}
+
+TEST(FootTracker, EncodedH264ClipGivesTheLiftoffRotationWithinTolerance) {
+  // the whole way a camera file goes: rendered, encoded with B-frames, decoded
+  synth::TrialSpec spec = BaseSpec();
+  spec.camera.codec = synth::VideoCodec::kH264;
+  liftoff::testing::ScratchDir scratch;
+  Result<synth::WrittenTrial> written = synth::WriteTrial(spec, TestCalibration(), scratch.path());
+  ASSERT_TRUE(written.ok()) << written.status().ToString();
+  const synth::GroundTruth& truth = written->truth;
+
+  FootTracker::Options options;
+  options.foot_roi_px = {truth.foot_roi_px.x_px, truth.foot_roi_px.y_px, truth.foot_roi_px.width_px,
+                         truth.foot_roi_px.height_px};
+  options.px_per_mm = truth.px_per_mm;
+  options.tape_colour = truth.foot;
+  FootTracker tracker(options);
+  cv::VideoCapture capture(written->video_path.string(), cv::CAP_FFMPEG);
+  ASSERT_TRUE(capture.isOpened());
+  Frame frame;
+  while (capture.read(frame.bgr)) {
+    ASSERT_LT(static_cast<size_t>(frame.index), truth.frame_times_ns.size());
+    frame.t_ns = truth.frame_times_ns[static_cast<size_t>(frame.index)];
+    ASSERT_TRUE(tracker.Process(frame).ok());
+    ++frame.index;
+  }
+  EXPECT_EQ(static_cast<size_t>(frame.index), truth.frame_times_ns.size());
+  tracker.SetRestWindow(*truth.led_on_video_ns, *truth.led_on_video_ns + 200'000'000);
+  Result<FootTrack> track = tracker.Finish();
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  const double error_s =
+      static_cast<double>(track->above_threshold.t_ns - *truth.liftoff_1mm_video_ns) / 1e9;
+  EXPECT_LT(std::abs(error_s * spec.motion.ramp_rate_rad_per_s), 0.01) << track->Brief();
+}
+
+// ---------------------------------------------------------------------------------------
+// invalid input
+
+TEST(FootTracker, RegionOutsideTheFrameIsInvalidArgument) {
+  FootTracker::Options options;
+  options.foot_roi_px = cv::Rect(600, 400, 80, 90);
+  FootTracker tracker(options);
+  Frame frame;
+  frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(90));
+  const Status status = tracker.Process(frame);
+  EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(status.message(), "foot ROI 600x400+80x90 is outside the 640x480 frame");
+
+  options.foot_roi_px = cv::Rect(-5, 100, 40, 60);
+  FootTracker left_of_it(options);
+  EXPECT_EQ(left_of_it.Process(frame).message(),
+            "foot ROI -5x100+40x60 is outside the 640x480 frame");
+
+  options.foot_roi_px = cv::Rect(100, 100, 40, 60);
+  options.reference_roi_px = cv::Rect(620, 10, 40, 40);
+  FootTracker with_reference(options);
+  const Status reference = with_reference.Process(frame);
+  EXPECT_EQ(reference.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(reference.message().find("reference ROI 620x10+40x40 is outside"), std::string::npos);
+}
+
+TEST(FootTracker, InvalidOptionsAreRejectedNamingTheField) {
+  const auto message = [](const std::function<void(FootTracker::Options&)>& change) {
+    FootTracker::Options options;
+    options.foot_roi_px = cv::Rect(10, 10, 40, 60);
+    change(options);
+    return options.Validate().message();
+  };
+  EXPECT_EQ(message([](auto&) {}), "");
+  EXPECT_NE(message([](auto& o) { o.foot_roi_px = {}; }).find("foot_roi_px"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.threshold_mm = 0; }).find("threshold_mm"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.threshold_px = -1; }).find("threshold_px"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.px_per_mm = -1; }).find("px_per_mm"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.foot_width_mm = 0; }).find("foot_width_mm"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.rest_frames = 1; }).find("rest_frames"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.exposure_s = -1; }).find("exposure_s"), std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.confirm_frames = 0; }).find("confirm_frames"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& o) { o.min_quality = 2; }).find("min_quality"), std::string::npos);
+
+  // the tracker reports its options' error
+  FootTracker::Options bad;
+  FootTracker tracker(bad);
+  Frame frame;
+  frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(90));
+  EXPECT_EQ(tracker.Process(frame).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(tracker.Finish().status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(FootTracker, NoFramesOrFramesOutOfOrderAreInvalidArgument) {
+  FootTracker::Options options;
+  options.foot_roi_px = cv::Rect(100, 100, 40, 60);
+  FootTracker tracker(options);
+  EXPECT_EQ(tracker.Finish().status().code(), StatusCode::kInvalidArgument);
+
+  Frame frame;
+  frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(90));
+  frame.t_ns = 1'000'000'000;
+  ASSERT_TRUE(tracker.Process(frame).ok());
+  frame.index = 1;
+  frame.t_ns = 900'000'000;
+  EXPECT_EQ(tracker.Process(frame).code(), StatusCode::kInvalidArgument);
+  frame.t_ns = 1'100'000'000;
+  frame.bgr = cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(90));
+  EXPECT_EQ(tracker.Process(frame).code(), StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace liftoff::video

@@ -1,1 +1,526 @@
-// placeholder: being written
+// The LED detector against exact switch-on instants: frame streams drawn here (several
+// pulses, on at the start, dim, never on) and synthetic trials rendered by synth (a
+// partial-exposure frame in lossless FFV1, noise, flicker, shake, bloom and saturation),
+// with the LED's region given and located automatically.
+#include "liftoff/video/led_detector.h"
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "liftoff/core/calibration.h"
+#include "liftoff/synth/spec.h"
+#include "liftoff/synth/trial_writer.h"
+#include "liftoff/video/video_reader.h"
+#include "support/test_support.h"
+
+namespace liftoff::video {
+namespace {
+
+namespace fs = std::filesystem;
+using ::liftoff::testing::ScratchDir;
+using ::liftoff::testing::SourceDir;
+using ::testing::HasSubstr;
+
+// ---------------------------------------------------------------------------------------
+// frame streams drawn here: a textured wall, a dark bar sliding down (something that
+// moves, not a pulse) and an LED disc lit by the exact fraction of each exposure it was
+// on
+
+struct LedStream {
+  cv::Size size{320, 240};
+  double fps = 60.0;
+  double exposure_s = 1.0 / 120.0;
+  cv::Point led_px{250, 50};
+  int radius_px = 5;
+  cv::Scalar board_bgr{30, 30, 30};
+  cv::Scalar off_bgr{40, 42, 45};
+  cv::Scalar on_bgr{70, 90, 250};
+  /// [on, off) intervals, video clock, s.
+  std::vector<std::pair<double, double>> on_s;
+  int frames = 100;
+
+  double PeriodNs() const { return 1e9 / fps; }
+  int64_t FrameNs(int index) const { return std::llround(index * PeriodNs()); }
+  cv::Rect LedRoi() const {
+    const int half = radius_px + 6;
+    return cv::Rect(led_px.x - half, led_px.y - half, 2 * half + 1, 2 * half + 1);
+  }
+};
+
+// Lit fraction of the exposure [t, t + E).
+double LitFraction(const LedStream& stream, int64_t t_ns) {
+  const double start_s = static_cast<double>(t_ns) * 1e-9, end_s = start_s + stream.exposure_s;
+  double lit_s = 0.0;
+  for (const auto& [on_s, off_s] : stream.on_s) {
+    lit_s += std::max(0.0, std::min(end_s, off_s) - std::max(start_s, on_s));
+  }
+  return lit_s / stream.exposure_s;
+}
+
+std::vector<Frame> DrawStream(const LedStream& stream) {
+  cv::Mat wall(stream.size, CV_8UC3);
+  cv::RNG rng(12345);
+  rng.fill(wall, cv::RNG::UNIFORM, cv::Scalar::all(60), cv::Scalar::all(160));
+  cv::GaussianBlur(wall, wall, cv::Size(0, 0), 3.0);
+  cv::rectangle(wall, cv::Rect(stream.led_px.x - 20, stream.led_px.y - 20, 41, 41),
+                stream.board_bgr, cv::FILLED);
+  std::vector<Frame> frames;
+  for (int index = 0; index < stream.frames; ++index) {
+    cv::Mat off = wall.clone();
+    cv::rectangle(off, cv::Rect(40, 60 + index, 60, 30), cv::Scalar(20, 25, 30), cv::FILLED);
+    cv::Mat on = off.clone();
+    cv::circle(off, stream.led_px, stream.radius_px, stream.off_bgr, cv::FILLED, cv::LINE_AA);
+    cv::circle(on, stream.led_px, stream.radius_px, stream.on_bgr, cv::FILLED, cv::LINE_AA);
+    Frame frame;
+    frame.index = index;
+    frame.t_ns = stream.FrameNs(index);
+    const double lit = LitFraction(stream, frame.t_ns);
+    cv::addWeighted(off, 1.0 - lit, on, lit, 0.0, frame.bgr);
+    frames.push_back(std::move(frame));
+  }
+  return frames;
+}
+
+Result<LedResult> Detect(const std::vector<Frame>& frames, const LedDetector::Options& options) {
+  LedDetector detector(options);
+  for (const Frame& frame : frames) LIFTOFF_RETURN_IF_ERROR(detector.Process(frame));
+  return detector.Finish();
+}
+
+LedDetector::Options WithRoi(cv::Rect roi, double exposure_s = 0.0) {
+  LedDetector::Options options;
+  options.roi_px = roi;
+  options.exposure_s = exposure_s;
+  return options;
+}
+LedDetector::Options Located(double exposure_s = 0.0) { return WithRoi(cv::Rect(), exposure_s); }
+
+// Three pulses: on between exposures, on and off mid-exposure, a pulse of 12 frames.
+LedStream ThreePulses() {
+  LedStream stream;
+  stream.on_s = {{0.2041, 0.4503}, {0.6025, 0.9377}, {1.2, 1.4}};
+  stream.frames = 100;
+  return stream;
+}
+
+TEST(LedDetector, ReportsEveryPulseWithItsOnAndOffInstants) {
+  const LedStream stream = ThreePulses();
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const bool located : {false, true}) {
+    // exposure known: partial frames date the switch exactly, others within the gap
+    // between exposures (half of 1/120 s here); unknown: within half a frame
+    for (const double exposure_s : {stream.exposure_s, 0.0}) {
+      SCOPED_TRACE(std::string(located ? "located" : "roi") +
+                   (exposure_s > 0 ? ", exposure known" : ", exposure unknown"));
+      const auto result =
+          Detect(frames, located ? Located(exposure_s) : WithRoi(stream.LedRoi(), exposure_s));
+      ASSERT_TRUE(result.ok()) << result.status().ToString();
+      ASSERT_EQ(result->pulses.size(), 3u) << result->Brief();
+      EXPECT_TRUE(result->warnings.empty()) << result->warnings.front();
+      for (size_t i = 0; i < 3; ++i) {
+        const LedPulse& pulse = result->pulses[i];
+        const double on_ns = stream.on_s[i].first * 1e9, off_ns = stream.on_s[i].second * 1e9;
+        const double bound_ns = 0.5 * stream.PeriodNs();
+        EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - on_ns), bound_ns) << "pulse " << i;
+        EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - on_ns),
+                  static_cast<double>(pulse.on_uncertainty_ns) + 1e5)
+            << "pulse " << i;
+        ASSERT_TRUE(pulse.off_ns.has_value()) << "pulse " << i;
+        EXPECT_LE(std::abs(static_cast<double>(*pulse.off_ns) - off_ns), bound_ns) << "pulse " << i;
+        EXPECT_LE(std::abs(static_cast<double>(*pulse.off_ns) - off_ns),
+                  static_cast<double>(pulse.off_uncertainty_ns) + 1e5)
+            << "pulse " << i;
+      }
+      // partial frames: frame 12 ([0.2, 0.2083) s) is lit 51 %, frame 36 70 %, frame 56
+      // (the second switch-off) 52 %; with the exposure known they date the switch exactly
+      EXPECT_EQ(result->pulses[0].first_lit_frame, 12);
+      EXPECT_NEAR(result->pulses[0].first_lit_fraction, 0.508, 0.02);
+      EXPECT_EQ(result->pulses[1].first_lit_frame, 36);
+      EXPECT_NEAR(result->pulses[1].first_lit_fraction, 0.7, 0.02);
+      EXPECT_EQ(result->pulses[2].first_lit_frame, 72);
+      EXPECT_EQ(result->pulses[2].first_lit_fraction, 1.0);
+      if (exposure_s > 0) {
+        const double close_ns = 0.02 * stream.PeriodNs();
+        EXPECT_NEAR(static_cast<double>(result->pulses[0].on_ns), 0.2041e9, close_ns);
+        EXPECT_NEAR(static_cast<double>(result->pulses[1].on_ns), 0.6025e9, close_ns);
+        EXPECT_NEAR(static_cast<double>(*result->pulses[1].off_ns), 0.9377e9, close_ns);
+      }
+      EXPECT_EQ(result->roi_located, located);
+    }
+  }
+}
+
+TEST(LedDetector, WarnsWhenTheLedIsAlreadyOnAtTheStart) {
+  LedStream stream;
+  stream.on_s = {{0.0, 0.3}, {0.6, 2.0}};
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const LedDetector::Options& options : {WithRoi(stream.LedRoi()), Located()}) {
+    const auto result = Detect(frames, options);
+    ASSERT_TRUE(result.ok()) << result.status().ToString();
+    ASSERT_EQ(result->pulses.size(), 1u);
+    EXPECT_NEAR(static_cast<double>(result->pulses[0].on_ns), 0.6e9, 0.5 * stream.PeriodNs());
+    ASSERT_EQ(result->warnings.size(), 1u);
+    EXPECT_THAT(result->warnings[0], HasSubstr("already on"));
+  }
+}
+
+TEST(LedDetector, OnAllAlongAndOffOnceIsNotASwitchOn) {
+  LedStream stream;
+  stream.on_s = {{0.0, 0.5}};
+  const auto result = Detect(DrawStream(stream), Located());
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), StatusCode::kNotFound);
+  EXPECT_THAT(result.status().message(), HasSubstr("already on"));
+}
+
+TEST(LedDetector, WarnsWhenTheLedIsDim) {
+  // the brightest channel rises by 14 grey levels (red 45 -> 59)
+  LedStream stream;
+  stream.on_bgr = cv::Scalar(40, 42, 59);
+  stream.radius_px = 6;
+  stream.on_s = {{0.5, 2.0}};
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const LedDetector::Options& options : {WithRoi(stream.LedRoi()), Located()}) {
+    const auto result = Detect(frames, options);
+    ASSERT_TRUE(result.ok()) << result.status().ToString();
+    EXPECT_NEAR(result->contrast_levels, 14.0, 1.0);
+    EXPECT_NEAR(static_cast<double>(result->pulses.at(0).on_ns), 0.5e9, 0.5 * stream.PeriodNs());
+    ASSERT_EQ(result->warnings.size(), 1u);
+    EXPECT_THAT(result->warnings[0], HasSubstr("LED dim: on-off contrast 14 grey levels"));
+  }
+}
+
+TEST(LedDetector, FindsAnLedOnABrightBoard) {
+  // the board is brighter than the lit LED in two channels: the brightest pixel barely
+  // changes, the LED's mean does
+  LedStream stream;
+  stream.board_bgr = cv::Scalar(225, 225, 225);
+  stream.on_s = {{0.5, 2.0}};
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const LedDetector::Options& options : {WithRoi(stream.LedRoi()), Located()}) {
+    const auto result = Detect(frames, options);
+    ASSERT_TRUE(result.ok()) << result.status().ToString();
+    ASSERT_EQ(result->pulses.size(), 1u);
+    EXPECT_NEAR(static_cast<double>(result->pulses[0].on_ns), 0.5e9, 0.5 * stream.PeriodNs());
+    EXPECT_GE(result->contrast_levels, 20.0);
+  }
+}
+
+TEST(LedDetector, LedFainterThanTheMinimumContrastIsNotFound) {
+  LedStream stream;
+  stream.on_bgr = cv::Scalar(40, 42, 50);  // +5 grey levels
+  stream.radius_px = 6;
+  stream.on_s = {{0.5, 2.0}};
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const LedDetector::Options& options : {WithRoi(stream.LedRoi()), Located()}) {
+    const auto result = Detect(frames, options);
+    ASSERT_FALSE(result.ok());
+    EXPECT_EQ(result.status().code(), StatusCode::kNotFound);
+    EXPECT_THAT(result.status().message(), HasSubstr("never switches on"));
+    EXPECT_THAT(result.status().message(), HasSubstr("5 grey levels"));
+  }
+  // a lower minimum accepts it, with a warning
+  LedDetector::Options options = Located();
+  options.min_contrast_levels = 3.0;
+  const auto result = Detect(frames, options);
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  EXPECT_FALSE(result->warnings.empty());
+}
+
+TEST(LedDetector, LedNeverOnIsNotFound) {
+  LedStream stream;  // nothing lit; only the bar moves
+  const std::vector<Frame> frames = DrawStream(stream);
+  for (const LedDetector::Options& options : {WithRoi(stream.LedRoi()), Located()}) {
+    const auto result = Detect(frames, options);
+    ASSERT_FALSE(result.ok());
+    EXPECT_EQ(result.status().code(), StatusCode::kNotFound);
+    EXPECT_THAT(result.status().message(), HasSubstr("the LED never switches on"));
+  }
+}
+
+TEST(LedDetector, RoiOutsideTheFrameIsInvalidArgument) {
+  LedStream stream;
+  stream.frames = 2;
+  const std::vector<Frame> frames = DrawStream(stream);
+  LedDetector detector(WithRoi(cv::Rect(300, 200, 40, 60)));
+  const Status status = detector.Process(frames[0]);
+  EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(status.message(), "LED ROI 300x200+40x60 is outside the 320x240 frame");
+}
+
+TEST(LedDetector, FramesOutOfOrderOrOfAnotherSizeAreInvalidArgument) {
+  LedStream stream;
+  stream.frames = 3;
+  std::vector<Frame> frames = DrawStream(stream);
+  LedDetector detector(Located());
+  ASSERT_TRUE(detector.Process(frames[1]).ok());
+  EXPECT_EQ(detector.Process(frames[0]).code(), StatusCode::kInvalidArgument);
+  cv::resize(frames[2].bgr, frames[2].bgr, cv::Size(160, 120));
+  EXPECT_EQ(detector.Process(frames[2]).code(), StatusCode::kInvalidArgument);
+}
+
+TEST(LedDetector, NoFrameIsInvalidArgument) {
+  LedDetector detector(Located());
+  EXPECT_EQ(detector.Finish().status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(LedDetector, OptionsOutOfRangeAreNamed) {
+  const auto message = [](auto change) {
+    LedDetector::Options options;
+    change(options);
+    return options.Validate().message();
+  };
+  EXPECT_TRUE(LedDetector::Options{}.Validate().ok());
+  EXPECT_THAT(message([](auto& o) { o.cell_px = 2; }), HasSubstr("cell_px"));
+  EXPECT_THAT(message([](auto& o) { o.threshold_frac = 1.0; }), HasSubstr("threshold_frac"));
+  EXPECT_THAT(message([](auto& o) { o.min_on_frames = 0; }), HasSubstr("min_on_frames"));
+  EXPECT_THAT(message([](auto& o) { o.min_contrast_levels = 0; }),
+              HasSubstr("min_contrast_levels"));
+  EXPECT_THAT(message([](auto& o) { o.dim_warning_levels = 4; }), HasSubstr("dim_warning_levels"));
+  EXPECT_THAT(message([](auto& o) { o.exposure_s = -1; }), HasSubstr("exposure_s"));
+  EXPECT_THAT(message([](auto& o) { o.roi_px = cv::Rect(0, 0, 10, 0); }), HasSubstr("roi_px"));
+  // a detector with bad options says so when fed
+  LedDetector::Options options;
+  options.min_on_frames = 0;
+  LedDetector detector(options);
+  LedStream stream;
+  stream.frames = 1;
+  EXPECT_EQ(detector.Process(DrawStream(stream)[0]).code(), StatusCode::kInvalidArgument);
+}
+
+TEST(LedResult, BriefSaysWhenWhereAndHowMany) {
+  LedResult result;
+  result.roi_px = cv::Rect(590, 50, 28, 28);
+  result.roi_located = true;
+  LedPulse pulse;
+  pulse.on_ns = 616'700'000;
+  pulse.on_uncertainty_ns = 4'200'000;
+  pulse.first_lit_frame = 37;
+  pulse.first_lit_fraction = 0.64;
+  result.pulses = {pulse};
+  EXPECT_EQ(
+      result.Brief(),
+      "LED on at 0.6167 s +- 4.2 ms (frame 37, 64 % lit), ROI 590x50+28x28 (located), 1 pulse");
+}
+
+// ---------------------------------------------------------------------------------------
+// synthetic trials rendered by synth, once for the suite
+
+synth::TrialSpec SmallTrial(const std::string& id) {
+  synth::TrialSpec spec;
+  spec.id = id;
+  spec.seed = 11;
+  spec.duration_s = 1.2;
+  spec.camera.width_px = 320;
+  spec.camera.height_px = 240;
+  spec.camera.fps = 60.0;
+  spec.camera.exposure_s = 0.008;
+  spec.camera.codec = synth::VideoCodec::kH264;
+  spec.led.on_video_s = 0.5;
+  spec.motion.bend_start_s = 0.0;
+  spec.motion.bend_end_s = 0.2;
+  spec.motion.ramp_start_s = 0.3;
+  spec.motion.ramp_rate_rad_per_s = 0.3;
+  return spec;
+}
+
+class LedDetectorTrials : public ::testing::Test {
+ protected:
+  struct Trial {
+    fs::path video;
+    synth::GroundTruth truth;
+    double period_ns = 0.0;
+  };
+
+  static void SetUpTestSuite() {
+    scratch_ = std::make_unique<ScratchDir>();
+    auto calibration = LoadCalibration(SourceDir() / "calib" / "laika-2018.json");
+    ASSERT_TRUE(calibration.ok()) << calibration.status().ToString();
+    const auto add = [&](const synth::TrialSpec& spec) {
+      auto written = synth::WriteTrial(spec, *calibration, scratch_->path());
+      ASSERT_TRUE(written.ok()) << written.status().ToString();
+      trials_[spec.id] = Trial{written->video_path, written->truth, 1e9 / spec.camera.fps};
+    };
+    {
+      // lossless, a full-frame exposure, on 40 % into frame 12's exposure: lit 60 %
+      synth::TrialSpec spec = SmallTrial("partial-ffv1");
+      spec.camera.codec = synth::VideoCodec::kFfv1;
+      spec.camera.fps = 30.0;
+      spec.camera.exposure_s = 1.0 / 30.0;
+      spec.led.on_video_s = 0.4 + 0.4 / 30.0;
+      add(spec);
+    }
+    {
+      synth::TrialSpec spec = SmallTrial("noise");
+      spec.nuisance.noise_sigma = 12.0;
+      add(spec);
+    }
+    {
+      // 100 Hz flicker seen through a 4 ms exposure at 30 fps: the scene's brightness
+      // swings by a third from frame to frame
+      synth::TrialSpec spec = SmallTrial("flicker");
+      spec.camera.codec = synth::VideoCodec::kMjpeg;
+      spec.camera.quality = 5;
+      spec.camera.fps = 30.0;
+      spec.camera.exposure_s = 0.004;
+      spec.nuisance.flicker_amplitude = 0.4;
+      spec.nuisance.flicker_hz = 100.0;
+      add(spec);
+    }
+    {
+      synth::TrialSpec spec = SmallTrial("shake");
+      spec.nuisance.shake_px = 1.5;
+      add(spec);
+    }
+    {
+      // a large white LED far brighter than the sensor's range, with a wide glow
+      synth::TrialSpec spec = SmallTrial("bloom-saturated");
+      spec.nuisance.noise_sigma = 2.0;
+      spec.led.blue = spec.led.green = spec.led.red = 255;
+      spec.led.intensity = 3.0;
+      spec.led.bloom = 4.0;
+      spec.led.radius_px = 8.0;
+      add(spec);
+    }
+    {
+      // never on, with everything else that changes: shake, noise, a strong codec
+      synth::TrialSpec spec = SmallTrial("never-on-shake");
+      spec.camera.quality = 30;
+      spec.nuisance.shake_px = 2.0;
+      spec.nuisance.noise_sigma = 8.0;
+      spec.led.on_video_s = -1.0;
+      add(spec);
+    }
+  }
+  static void TearDownTestSuite() {
+    trials_.clear();
+    scratch_.reset();
+  }
+  static const Trial& Get(const std::string& id) { return trials_.at(id); }
+
+  static cv::Rect TruthRoi(const Trial& trial) {
+    const RegionPx& roi = trial.truth.led_roi_px;
+    return cv::Rect(roi.x_px, roi.y_px, roi.width_px, roi.height_px);
+  }
+
+  static Result<LedResult> DetectInVideo(const Trial& trial, const LedDetector::Options& options) {
+    LIFTOFF_ASSIGN_OR_RETURN(VideoReader reader, VideoReader::Open(trial.video));
+    LedDetector detector(options);
+    Frame frame;
+    for (;;) {
+      LIFTOFF_ASSIGN_OR_RETURN(const bool more, reader.Next(frame));
+      if (!more) break;
+      LIFTOFF_RETURN_IF_ERROR(detector.Process(frame));
+    }
+    return detector.Finish();
+  }
+
+  // the switch-on within half a frame of truth, and inside the reported uncertainty, with
+  // the truth's ROI and located automatically
+  static void ExpectSwitchOnWithinHalfAFrame(const std::string& id) {
+    const Trial& trial = Get(id);
+    ASSERT_TRUE(trial.truth.led_on_video_ns.has_value());
+    const auto truth_ns = static_cast<double>(*trial.truth.led_on_video_ns);
+    for (const bool located : {false, true}) {
+      SCOPED_TRACE(id + (located ? " located" : " with the truth's ROI"));
+      const auto result = DetectInVideo(trial, located ? Located() : WithRoi(TruthRoi(trial)));
+      ASSERT_TRUE(result.ok()) << result.status().ToString();
+      ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+      const LedPulse& pulse = result->pulses[0];
+      const double error_ns = static_cast<double>(pulse.on_ns) - truth_ns;
+      EXPECT_LE(std::abs(error_ns), 0.5 * trial.period_ns) << result->Brief();
+      EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns) + 1e5);
+      EXPECT_FALSE(pulse.off_ns.has_value());
+      EXPECT_TRUE(result->warnings.empty()) << result->warnings.front();
+      if (located) {
+        // the located region holds the LED's centre
+        const cv::Rect truth_roi = TruthRoi(trial);
+        const cv::Point centre(truth_roi.x + truth_roi.width / 2,
+                               truth_roi.y + truth_roi.height / 2);
+        EXPECT_TRUE(result->roi_px.contains(centre)) << result->Brief();
+      }
+    }
+  }
+
+ private:
+  static inline std::unique_ptr<ScratchDir> scratch_;
+  static inline std::map<std::string, Trial> trials_;
+};
+
+TEST_F(LedDetectorTrials, PartialFrameGivesTheExactInstantWhenTheExposureIsKnown) {
+  const Trial& trial = Get("partial-ffv1");
+  ASSERT_EQ(trial.truth.led_first_frame, 12);
+  ASSERT_NEAR(trial.truth.led_first_frame_fraction, 0.6, 1e-6);
+  const auto truth_ns = static_cast<double>(*trial.truth.led_on_video_ns);
+  for (const LedDetector::Options& options :
+       {WithRoi(TruthRoi(trial), 1.0 / 30.0), Located(1.0 / 30.0)}) {
+    const auto result = DetectInVideo(trial, options);
+    ASSERT_TRUE(result.ok()) << result.status().ToString();
+    const LedPulse& pulse = result->pulses.at(0);
+    EXPECT_EQ(pulse.first_lit_frame, 12);
+    EXPECT_NEAR(pulse.first_lit_fraction, 0.6, 0.01);
+    EXPECT_NEAR(static_cast<double>(pulse.on_ns), truth_ns, 0.01 * trial.period_ns);
+    EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - truth_ns),
+              static_cast<double>(pulse.on_uncertainty_ns) + 1e5);
+  }
+}
+
+TEST_F(LedDetectorTrials, PartialFrameWithUnknownExposureIsWithinHalfAFrame) {
+  ExpectSwitchOnWithinHalfAFrame("partial-ffv1");
+}
+
+TEST_F(LedDetectorTrials, AutomaticLocatingFindsTheTruthRoi) {
+  for (const std::string id : {"partial-ffv1", "noise", "flicker", "shake", "bloom-saturated"}) {
+    const Trial& trial = Get(id);
+    const auto result = DetectInVideo(trial, Located());
+    ASSERT_TRUE(result.ok()) << id << ": " << result.status().ToString();
+    EXPECT_TRUE(result->roi_located);
+    const cv::Rect truth = TruthRoi(trial);
+    const cv::Point2d truth_centre(truth.x + 0.5 * truth.width, truth.y + 0.5 * truth.height);
+    const cv::Point2d centre(result->roi_px.x + 0.5 * result->roi_px.width,
+                             result->roi_px.y + 0.5 * result->roi_px.height);
+    EXPECT_LE(cv::norm(centre - truth_centre), 6.0) << id << ": " << result->Brief();
+    EXPECT_GT((result->roi_px & truth).area(), truth.area() / 2) << id << ": " << result->Brief();
+  }
+}
+
+TEST_F(LedDetectorTrials, FindsTheSwitchOnUnderSensorNoise) {
+  ExpectSwitchOnWithinHalfAFrame("noise");
+}
+
+TEST_F(LedDetectorTrials, FindsTheSwitchOnUnderMainsFlicker) {
+  ExpectSwitchOnWithinHalfAFrame("flicker");
+}
+
+TEST_F(LedDetectorTrials, FindsTheSwitchOnUnderCameraShake) {
+  ExpectSwitchOnWithinHalfAFrame("shake");
+}
+
+TEST_F(LedDetectorTrials, FindsTheSwitchOnOfASaturatedLedWithBloom) {
+  ExpectSwitchOnWithinHalfAFrame("bloom-saturated");
+}
+
+TEST_F(LedDetectorTrials, LedNeverOnIsNotFoundDespiteShakeAndNoise) {
+  const Trial& trial = Get("never-on-shake");
+  for (const LedDetector::Options& options : {WithRoi(TruthRoi(trial)), Located()}) {
+    const auto result = DetectInVideo(trial, options);
+    ASSERT_FALSE(result.ok()) << result->Brief();
+    EXPECT_EQ(result.status().code(), StatusCode::kNotFound);
+    EXPECT_THAT(result.status().message(), HasSubstr("the LED never switches on"));
+  }
+}
+
+}  // namespace
+}  // namespace liftoff::video

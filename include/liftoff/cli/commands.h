@@ -58,6 +58,13 @@ struct TableCommand {
   std::filesystem::path sim_path;
   /// Write the tables here instead of `out`.
   std::filesystem::path output_path;
+  /// The per-foot hardware-vs-simulation plot (SVG) to write; empty: none.
+  std::filesystem::path plot_path;
+  /// Trials whose times come from their video: write <dir>/<trial id>.png, a verification
+  /// image, for each; empty: none.
+  std::filesystem::path verify_dir;
+  /// Progress on stderr while videos are analysed: auto, live, lines or off.
+  std::string progress = "auto";
 };
 int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err);
 

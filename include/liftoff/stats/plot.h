@@ -25,6 +25,7 @@ struct PlotOptions {
 /// Renders `table` (BuildResultsTable) as an SVG document. The caption names the
 /// calibration and the lookup rule, as every table rendering does. Feet without values
 /// keep their column, empty. Trials whose liftoff_rad is NaN are not drawn.
-Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOptions& options = {});
+Result<std::string> RenderResultsPlotSvg(const ResultsTable& table,
+                                         const PlotOptions& options = {});
 
 }  // namespace liftoff::stats

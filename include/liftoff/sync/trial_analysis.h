@@ -1,9 +1,12 @@
 // A whole trial manifest, trial by trial: load each controller log, map the trial's
-// video times onto it and read the vertebra angle at liftoff. One trial's failure never
-// stops the others; each carries its own Status.
+// video times onto it and read the vertebra angle at liftoff. The video times are the
+// trial's hand-given ones, or, for a trial with a video and no times, found by video
+// analysis (video::AnalyzeClip). One trial's failure never stops the others; each carries
+// its own Status.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +17,7 @@
 #include "liftoff/core/status.h"
 #include "liftoff/stats/table.h"
 #include "liftoff/sync/lookup.h"
+#include "liftoff/video/clip_analysis.h"
 
 namespace liftoff::sync {
 
@@ -22,8 +26,21 @@ struct AnalysisOptions {
   LookupOptions lookup;
   /// How tolerant the log readers are.
   LogReadOptions log;
+  /// Video analysis of the trials that have a video and no times. Each trial's record
+  /// fills in its own parts: the LED region (roi.led_px; without it the LED is located
+  /// automatically, unless video.led.roi_px is set), the foot region (roi.foot_px,
+  /// required), the tape colour of its foot (when use_tape_colour) and the pixel scale
+  /// (video.px_per_mm; without it video.foot.px_per_mm, 0 = estimated from the foot's
+  /// width).
+  video::ClipAnalysisOptions video;
+  /// Track the foot by its tape colour (A blue, B orange, C purple, D red) as well as by
+  /// its edges.
+  bool use_tape_colour = true;
+  /// Called while a trial's video is analysed: the trial, frames done, the last frame's
+  /// time (video clock, ns). May be empty.
+  std::function<void(const TrialRecord& trial, int64_t frames_done, int64_t t_ns)> video_progress;
 
-  /// Both parts' checks.
+  /// Every part's checks (the video options without a foot region: that is per trial).
   Status Validate() const;
 };
 
@@ -38,6 +55,9 @@ struct TrialOutcome {
   std::optional<LiftoffMeasurement> measurement;
   /// What the log reader made of the trial's log (empty when it was never read).
   LogReadReport log_report;
+  /// The video analysis, when the trial's times came from its video (kept even when the
+  /// lookup on the log then failed): regions, pulses, the foot's track, warnings.
+  std::optional<video::ClipAnalysis> video;
 };
 
 struct ManifestAnalysis {
@@ -52,14 +72,18 @@ struct ManifestAnalysis {
 
   /// The successful trials' |angles| with their intervals, in manifest order. flags sum up
   /// what to be wary of, separated by "; ": "gap 0.93 s", "past end 0.091 s",
-  /// "before start 0.010 s"; empty when nothing.
+  /// "before start 0.010 s", "video: 2 warnings" (times from video analysis that warned);
+  /// empty when nothing.
   std::vector<stats::TrialValue> Values() const;
 };
 
 /// Analyses every trial of `manifest`: loads its log with capture::LoadControllerLog
-/// (through `calibration`), takes its hand-given times and measures the liftoff angle.
-/// A trial with a video but no times fails kUnsupported (automatic video analysis is not
-/// available yet); with neither, kInvalidArgument. Invalid options fail every trial.
+/// (through `calibration`), takes its hand-given times, or analyses its video when it has
+/// a video and no times (LED switch-on and liftoff, source "video"), and measures the
+/// liftoff angle. Hand times win when a trial has both. A trial with a video and no times
+/// fails with the video analysis' error (kInvalidArgument without a foot region, kNotFound
+/// when the LED never switches on or the foot never lifts, kParse for a damaged video, ...);
+/// with neither a video nor times, kInvalidArgument. Invalid options fail every trial.
 ManifestAnalysis AnalyzeManifest(const TrialManifest& manifest, const Calibration& calibration,
                                  const AnalysisOptions& options);
 

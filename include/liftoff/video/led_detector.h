@@ -3,13 +3,40 @@
 // sub-frame precision where a frame caught the switch-on mid-exposure.
 //
 // The brightness of the LED region in a frame whose exposure [t, t + E) saw the LED on
-// for the last fraction f of it is off + f (on - off) (linear in every unsaturated pixel
-// and in a clipped one too, since the camera integrates light that is then clipped
-// identically in the on and off parts only when neither saturates: the detector measures
-// f against the frame after and before it, which works under saturation because the
-// region's mean is taken over pixels that reach the same clip in every lit frame). So
-// the switch-on instant is t + (1 - f) E. E (the exposure) is rarely known: by default it
-// is taken as the frame interval, which bounds the error by half an interval.
+// for the last fraction f of it is off + f (on - off): every pixel integrates the light,
+// so the region's sum is linear in f, also where the lit LED clips at 255 (the on level
+// is then the clipped one). The detector measures f against the levels of the frames
+// before and after the step, so the switch-on instant is t + (1 - f) E. When the LED
+// switched on between two exposures (f = 1), it lies between the previous exposure's end
+// and this frame's start. E (the exposure) is rarely known: by default it is only bounded
+// by the camera's frame interval T, and the estimate is the middle of every instant
+// consistent with some exposure in (0, T] (t + (1 - f) T / 2 for a partial frame, the
+// middle of the two frames' starts for a full one), which bounds the error by half a
+// frame interval. With Options::exposure_s the partial-frame estimate is exact up to the
+// noise of f. Each instant comes with the half-width of that interval as its uncertainty.
+//
+// Regions: with an ROI, the whole ROI is measured (it should hold the LED, its glow and a
+// margin for camera shake). Without one, the frame is cut into cells of cell_px (every
+// other row sampled) and every 2 x 2 block of cells is a candidate region; each keeps a
+// few frames of its brightness and a fixed-size record per step it made, never pixels.
+// The measure is the sum of B, G and R: the LED must brighten its region, not only change
+// its hue.
+//
+// A step counts when the region's brightness jumps and holds: the 4 frames before it and
+// the min_on_frames after it are flat compared with the step, it crosses threshold_frac of
+// the way between the two levels in one frame (or two, with a partly lit one), the
+// region's brightest channel (or its mean, if larger) steps by min_contrast_levels or
+// more, the step stands out from what the rest of the frame did at that instant (codec
+// key frames, lighting changes and camera shake step many regions at once), and the
+// region then holds its new level, or returns to the old one, for 8 more frames (a moving
+// foot does not). Mains flicker is taken out first: every frame's overall gain against a
+// slow average of each cell, applied to the scene's light only. When locating, the cells
+// around a step must look like a light switching (no cells stepping the other way, as an
+// edge moved by shake makes them; not a row or a column of cells, as a shifted band), and
+// the LED is the region with the largest step among those whose contrast is at least
+// half the best one's. Limits: a small, dim LED under strong camera shake is missed
+// rather than mistaken (the detector prefers kNotFound to a wrong instant); flicker is
+// over-corrected where the lit LED fills much of its region.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +65,8 @@ struct LedPulse {
   double first_lit_fraction = 1.0;
   /// Switch-off instant, ns, when the LED went off again within the clip.
   std::optional<int64_t> off_ns;
+  /// Half-width of the interval that surely holds the switch-off, ns (0 without off_ns).
+  int64_t off_uncertainty_ns = 0;
 };
 
 /// What the LED detector found in a clip.
@@ -45,9 +74,14 @@ struct LedResult {
   /// Region measured, px; whether it was located automatically.
   cv::Rect roi_px;
   bool roi_located = false;
-  /// Mean brightness of the region, grey levels 0..255, off and on (medians).
+  /// Mean brightness of the region, grey levels 0..255 (mean of B, G and R), off and on
+  /// (medians of the frames around the first switch-on).
   double off_level = 0.0;
   double on_level = 0.0;
+  /// The LED's own on-off contrast: the step of the region's brightest colour channel
+  /// (its brightest pixel), grey levels 0..255, at the first switch-on. This is what
+  /// min_contrast_levels and dim_warning_levels are compared with.
+  double contrast_levels = 0.0;
   /// Every switch-on in the clip, in order (at least one: Finish fails otherwise).
   std::vector<LedPulse> pulses;
   /// For people: "LED dim: on-off contrast 9 grey levels (expected >= 20)", "LED already
@@ -64,17 +98,21 @@ class LedDetector {
   struct Options {
     /// Region to watch, px. Empty (0 x 0): locate the LED automatically.
     cv::Rect roi_px;
-    /// Automatic locating: cell size of the coarse brightness grid, px (4 .. 64).
+    /// Automatic locating: cell size of the coarse brightness grid, px (4 .. 64; a
+    /// multiple of 16 takes the fast path). The LED and its glow should fit in 2 x 2 cells.
     int cell_px = 16;
     /// A switch-on is a rise to above off + threshold_frac (on - off), 0 < x < 1 ...
     double threshold_frac = 0.5;
-    /// ... held for at least this many frames (flicker and noise are not pulses), >= 1.
+    /// ... held flat for at least this many frames (flicker and noise are not pulses),
+    /// 1 .. 100; the step is then confirmed over 8 more frames (see above).
     int min_on_frames = 3;
-    /// Smallest on-off contrast accepted as an LED, grey levels (> 0); below
-    /// dim_warning_levels a warning says the LED is dim.
+    /// Smallest on-off contrast accepted as an LED (LedResult::contrast_levels), grey
+    /// levels (> 0); below dim_warning_levels (>= min_contrast_levels) a warning says the
+    /// LED is dim.
     double min_contrast_levels = 8.0;
     double dim_warning_levels = 20.0;
-    /// Camera exposure time, s; 0 = unknown (taken as the frame interval).
+    /// Camera exposure time, s (>= 0, at most 1 s); 0 = unknown: any exposure up to the
+    /// frame interval is assumed (see above).
     double exposure_s = 0.0;
 
     Status Validate() const;

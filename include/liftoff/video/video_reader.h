@@ -2,8 +2,10 @@
 // container's frame count are never trusted (both lie for variable-frame-rate files):
 // each frame's time is read from the decoder (OpenCV's FFmpeg backend, CAP_PROP_POS_MSEC)
 // and checked. Known quirk repaired: the last frames of H.264 with B-frames read 0 ms;
-// they are extrapolated from the median interval and marked (Frame::t_repaired).
-// Dropped and irregular frames are reported in FrameTimingReport.
+// they (and any time that does not increase) are extrapolated from the median interval
+// and marked (Frame::t_repaired). Dropped and irregular frames are reported in
+// FrameTimingReport. Memory stays flat: one frame buffer, a few dozen intervals and a
+// fixed histogram.
 #pragma once
 
 #include <cstdint>
@@ -36,19 +38,26 @@ struct TimingIrregularity {
 
 /// What the timestamps of a whole clip looked like.
 struct FrameTimingReport {
-  int64_t frames = 0;              ///< frames decoded
-  int64_t first_ns = 0;            ///< first frame's time, ns
-  int64_t last_ns = 0;             ///< last frame's time, ns
-  int64_t median_interval_ns = 0;  ///< the usual interval (median of all), ns
-  double container_fps = 0.0;      ///< what the container claims (not used), Hz
-  int64_t container_frames = 0;    ///< what the container claims (not used)
-  int64_t dropped_frames = 0;      ///< sum of missing_frames
-  int64_t repaired_frames = 0;     ///< frames with t_repaired
+  int64_t frames = 0;    ///< frames decoded
+  int64_t first_ns = 0;  ///< first frame's time, ns
+  int64_t last_ns = 0;   ///< last frame's time, ns
+  /// The usual interval: the median of all read (not repaired) intervals, ns; exact for a
+  /// constant rate, else within 0.3 % (a fixed histogram keeps memory flat).
+  int64_t median_interval_ns = 0;
+  double container_fps = 0.0;    ///< what the container claims (not used), Hz
+  int64_t container_frames = 0;  ///< what the container claims (not used)
+  int64_t dropped_frames = 0;    ///< sum of missing_frames
+  int64_t repaired_frames = 0;   ///< frames with t_repaired
   /// Every irregular, dropped or repaired frame, in order (at most max_listed; the counts
   /// above are complete).
   std::vector<TimingIrregularity> irregularities;
-  int64_t irregular_frames = 0;    ///< count of kIrregular (complete)
-  /// "1432 frames, 16.667 ms median (60.0 fps), 3 dropped, 2 repaired, 0 irregular".
+  int64_t irregular_frames = 0;  ///< count of kIrregular (complete)
+  /// Errors FFmpeg's demuxer and decoder logged while reading (they are caught, not
+  /// printed): damage the decoder concealed, or that ended the stream. The first one's text.
+  int64_t decoder_errors = 0;
+  std::string first_decoder_error;
+  /// "1432 frames, 16.667 ms median (60.0 fps), 3 dropped, 2 repaired, 0 irregular"
+  /// (", 2 decoder errors" appended when there were any).
   std::string Brief() const;
 };
 
@@ -60,7 +69,9 @@ class VideoReader {
     /// irregular; one near n medians (n >= 2, within the fraction) is n - 1 drops. (0, 1).
     double irregular_tolerance_frac = 0.25;
     /// Intervals used to estimate the usual interval on the fly before the whole clip is
-    /// known (for repairs and drop counting while streaming); >= 3.
+    /// known, >= 3: each interval is judged against the median of the window centred on it
+    /// (so a rate that changes midway is followed), and a repair extrapolates by the
+    /// median of the last ones.
     int median_window_frames = 31;
     /// Most irregularities listed in the report (counts stay complete); >= 0.
     int max_listed = 1000;
@@ -72,16 +83,20 @@ class VideoReader {
   /// accepts it, or "truncated or damaged" when it looks like a video container (a known
   /// file signature) but cannot be opened or yields no frame. Messages name the file.
   static Result<VideoReader> Open(const std::filesystem::path& path, const Options& options);
-  static Result<VideoReader> Open(const std::filesystem::path& path) { return Open(path, Options{}); }
+  static Result<VideoReader> Open(const std::filesystem::path& path) {
+    return Open(path, Options{});
+  }
 
   VideoReader(VideoReader&&) noexcept;
   VideoReader& operator=(VideoReader&&) noexcept;
   ~VideoReader();
 
   /// Decodes the next frame into `frame` (its bgr buffer is reused). Returns false at the
-  /// end of the stream. kParse naming the file and frame when the stream ends in a way
-  /// that shows damage (e.g. decoding stops long before the container's stated length and
-  /// the decoder reported errors): the frames already returned stay valid.
+  /// end of the stream. kParse "truncated or damaged" naming the file and the last frame
+  /// when the stream ends short of what the container lists, both in frames and in time:
+  /// by a tenth, or by two frames when FFmpeg reported errors. The frames already returned
+  /// stay valid. FFmpeg's and OpenCV's own messages are caught while the reader works
+  /// (the first error goes into the message and FrameTimingReport), never printed.
   Result<bool> Next(Frame& frame);
 
   /// Image size, px.

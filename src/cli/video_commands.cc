@@ -1,0 +1,273 @@
+#include "liftoff/cli/video_commands.h"
+
+#include <unistd.h>
+
+#include <iostream>
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
+#include "liftoff/core/time.h"
+#include "liftoff/video/clip_analysis.h"
+#include "liftoff/video/verification.h"
+
+namespace liftoff::cli {
+namespace {
+
+// A number flag inside its range, else kInvalidArgument naming the flag.
+Status CheckNumberFlag(std::string_view flag, double value, const NumberRange& range,
+                       std::string_view unit) {
+  if (InNumberRange(value, range)) return Status::Ok();
+  return InvalidArgumentError(std::string(flag) + ": expected " + DescribeNumberRange(range) +
+                              (unit.empty() ? "" : " ") + std::string(unit) + ", got " +
+                              FormatNumber(value));
+}
+
+// "FROM,TO" seconds
+Result<std::pair<double, double>> ParseRestWindow(const std::string& text) {
+  const size_t comma = text.find(',');
+  const auto fail = [&] {
+    return InvalidArgumentError(
+        "--rest-window: expected FROM,TO in seconds relative to the LED switch-on, FROM < TO, "
+        "each in [-60, 60] (e.g. -0.5,0), got \"" +
+        text + "\"");
+  };
+  if (comma == std::string::npos) return fail();
+  try {
+    size_t used_from = 0, used_to = 0;
+    const std::string from_text = text.substr(0, comma);
+    const std::string to_text = text.substr(comma + 1);
+    const double from_s = std::stod(from_text, &used_from);
+    const double to_s = std::stod(to_text, &used_to);
+    if (used_from != from_text.size() || used_to != to_text.size()) return fail();
+    if (!(from_s < to_s) || from_s < -60.0 || to_s > 60.0) return fail();
+    return std::pair{from_s, to_s};
+  } catch (const std::exception&) {
+    return fail();
+  }
+}
+
+// the command's flags as analysis options
+Result<video::ClipAnalysisOptions> ClipOptionsFrom(const VideoCommand& command) {
+  video::ClipAnalysisOptions options;
+  if (!command.led_roi.empty()) {
+    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, video::ParseRect(command.led_roi, "--led-roi"));
+  }
+  if (!command.foot_roi.empty()) {
+    LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
+                             video::ParseRect(command.foot_roi, "--foot-roi"));
+  }
+  if (!command.foot.empty()) {
+    const std::optional<Foot> foot = ParseFoot(command.foot);
+    if (!foot) {
+      return InvalidArgumentError("--foot: expected A, B, C or D, got \"" + command.foot + "\"");
+    }
+    options.foot.tape_colour = *foot;
+  }
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckNumberFlag("--px-per-mm", command.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
+  LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-mm", command.threshold_mm,
+                                          {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckNumberFlag("--threshold-px", command.threshold_px, {.min = 0.0, .max = 1000.0}, "px"));
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckNumberFlag("--exposure-ms", command.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
+  options.foot.px_per_mm = command.px_per_mm;
+  options.foot.threshold_mm = command.threshold_mm;
+  options.foot.threshold_px = command.threshold_px;
+  options.led.exposure_s = 1e-3 * command.exposure_ms;
+  options.foot.exposure_s = options.led.exposure_s;
+  LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(command.rest_window));
+  options.rest_from_led_s = rest.first;
+  options.rest_to_led_s = rest.second;
+  const std::optional<video::LiftoffInstant> instant = video::ParseLiftoffInstant(command.liftoff);
+  if (!instant) {
+    return InvalidArgumentError("--liftoff: expected threshold or onset, got \"" + command.liftoff +
+                                "\"");
+  }
+  options.liftoff = *instant;
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+std::string Milliseconds(int64_t ns) {
+  return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
+}
+
+// the analysis for people
+void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
+  out << analysis.video_path.string() << " (" << analysis.width_px << "x" << analysis.height_px
+      << "): " << analysis.timing.Brief() << '\n'
+      << "LED: " << analysis.led.Brief() << '\n';
+  if (!analysis.foot) {
+    out << "foot: not analysed (no --foot-roi)\n";
+  } else {
+    const video::FootTrack& foot = *analysis.foot;
+    out << "foot: " << foot.Brief() << '\n'
+        << "rest window: " << FormatSeconds(analysis.rest_from_ns) << "-"
+        << FormatSeconds(analysis.rest_to_ns) << " s (" << Plural(analysis.rest_frames, "frame")
+        << "), noise " << FormatFixed(foot.rest_noise_px, 3) << " px, threshold "
+        << FormatFixed(foot.threshold_px, 3) << " px";
+    if (foot.px_per_mm > 0) {
+      out << " at " << FormatFixed(foot.px_per_mm, 3) << " px/mm"
+          << (foot.px_per_mm_estimated ? " (estimated from the foot's width)" : "");
+    }
+    out << '\n';
+  }
+  if (Result<EventTimes> events = analysis.Events(); events.ok()) {
+    out << "events: LED on " << FormatSeconds(events->led_on_ns, 4) << " s +- "
+        << Milliseconds(events->led_on_uncertainty_ns) << ", liftoff ("
+        << video::LiftoffInstantName(analysis.liftoff_instant) << ") "
+        << FormatSeconds(events->liftoff_ns, 4) << " s +- "
+        << Milliseconds(events->liftoff_uncertainty_ns) << "; interval LED on -> liftoff "
+        << FormatSeconds(events->liftoff_ns - events->led_on_ns, 4) << " s +- "
+        << Milliseconds(events->led_on_uncertainty_ns + events->liftoff_uncertainty_ns) << '\n';
+  }
+  for (const std::string& warning : analysis.warnings) out << "warning: " << warning << '\n';
+}
+
+// file names from trial ids: anything but letters, digits, '.', '_' and '-' becomes '_'
+std::string FileStem(const std::string& id) {
+  std::string stem = id.empty() ? std::string("trial") : id;
+  for (char& c : stem) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '_' || c == '-';
+    if (!keep) c = '_';
+  }
+  if (stem.front() == '.') stem.front() = '_';
+  return stem;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// progress
+
+Result<VideoProgress> VideoProgress::Create(std::string_view mode, std::ostream& err) {
+  if (mode != "auto" && mode != "live" && mode != "lines" && mode != "off") {
+    return InvalidArgumentError("--progress: expected auto, live, lines or off, got \"" +
+                                std::string(mode) + "\"");
+  }
+  const bool live = mode == "live" || (mode == "auto" && err.rdbuf() == std::cerr.rdbuf() &&
+                                       ::isatty(STDERR_FILENO) == 1);
+  return VideoProgress(err, live, mode == "off");
+}
+
+VideoProgress::VideoProgress(std::ostream& err, bool live, bool off)
+    : err_(&err),
+      live_(live),
+      off_(off),
+      started_ns_(MonotonicNowNs()),
+      last_shown_ns_(started_ns_) {}
+
+void VideoProgress::Show(std::string_view label, int64_t frames_done, int64_t t_ns) {
+  if (off_) return;
+  // each clip's rate from its own start
+  const int64_t now_ns = MonotonicNowNs();
+  if (label != label_) {
+    label_ = label;
+    started_ns_ = now_ns;
+  }
+  // live: at most 5 times a second; lines: every 5 s
+  const int64_t every_ns = live_ ? NsFromMilliseconds(200) : NsFromSeconds(5.0);
+  if (now_ns - last_shown_ns_ < every_ns) return;
+  last_shown_ns_ = now_ns;
+  const double wall_s = SecondsFromNs(now_ns - started_ns_);
+  const std::string text =
+      std::string(label) + ": frame " + std::to_string(frames_done) + ", " +
+      FormatSeconds(t_ns, 1) + " s of video, " +
+      FormatFixed(static_cast<double>(frames_done) / std::max(wall_s, 1e-3), 0) + " frames/s";
+  if (live_) {
+    *err_ << '\r' << text
+          << std::string(last_width_ > text.size() ? last_width_ - text.size() : 0, ' ')
+          << std::flush;
+    last_width_ = text.size();
+  } else {
+    *err_ << "video: " << text << std::endl;
+  }
+}
+
+void VideoProgress::Done() {
+  if (live_ && last_width_ > 0)
+    *err_ << '\r' << std::string(last_width_, ' ') << '\r' << std::flush;
+  last_width_ = 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff video
+
+int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) {
+  auto options = ClipOptionsFrom(command);
+  if (!options.ok()) return ReportError(options.status(), err);
+  auto progress = VideoProgress::Create(command.progress, err);
+  if (!progress.ok()) return ReportError(progress.status(), err);
+  const std::string label = command.video_path.filename().string();
+
+  // the pass
+  auto analysis = video::AnalyzeClip(
+      command.video_path, *options,
+      [&](int64_t frames_done, int64_t t_ns) { progress->Show(label, frames_done, t_ns); });
+  progress->Done();
+  if (!analysis.ok()) return ReportError(analysis.status(), err);
+
+  // proof, when asked for (a second decode)
+  Status verified;
+  video::VerificationReport verification;
+  if (!command.verify_path.empty() || !command.annotate_path.empty()) {
+    video::VerificationOptions verify_options;
+    verify_options.image_path = command.verify_path;
+    verify_options.video_path = command.annotate_path;
+    auto written = video::WriteVerification(*analysis, verify_options);
+    if (written.ok()) {
+      verification = std::move(written).value();
+    } else {
+      verified = written.status();
+    }
+  }
+
+  if (command.json) {
+    nlohmann::json document = analysis->ToJson();
+    document["verification"] = {{"image", verification.image_path.empty()
+                                              ? nlohmann::json()
+                                              : nlohmann::json(verification.image_path.string())},
+                                {"video", verification.video_path.empty()
+                                              ? nlohmann::json()
+                                              : nlohmann::json(verification.video_path.string())}};
+    out << document.dump(2) << '\n';
+  } else {
+    PrintAnalysis(*analysis, out);
+  }
+  if (!verified.ok()) return ReportError(verified, err);
+  if (!verification.image_path.empty() || !verification.video_path.empty()) {
+    err << "wrote " << verification.Brief() << '\n';
+  }
+  return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// liftoff table's verification images
+
+Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
+                               const std::filesystem::path& dir, std::ostream& err) {
+  Status first_failure;
+  for (const sync::TrialOutcome& outcome : analysis.outcomes) {
+    if (!outcome.video) continue;
+    video::VerificationOptions options;
+    options.image_path = dir / (FileStem(outcome.trial.id) + ".png");
+    auto written = video::WriteVerification(*outcome.video, options);
+    if (!written.ok()) {
+      const Status failure = written.status().WithContext(outcome.trial.id);
+      err << "error: " << failure.ToString() << '\n';
+      if (first_failure.ok()) first_failure = failure;
+      continue;
+    }
+    err << "wrote " << written->Brief() << '\n';
+  }
+  return first_failure;
+}
+
+}  // namespace liftoff::cli
