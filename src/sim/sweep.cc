@@ -26,66 +26,6 @@ std::string RunName(Foot foot, const TensionPoint& tension) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
-// one run, with progress
-
-Status RunControl::Validate() const {
-  if (!(progress_period_s > 0.0 && progress_period_s <= 3600.0)) {
-    return InvalidArgumentError("progress_period_s: expected a number in (0, 3600], got " +
-                                FormatNumber(progress_period_s));
-  }
-  return Status::Ok();
-}
-
-Result<ExperimentResult> RunExperimentWithProgress(const ModelDescription& description,
-                                                   const ExperimentOptions& options,
-                                                   const RunControl& control,
-                                                   const RunProgressCallback& progress) {
-  LIFTOFF_RETURN_IF_ERROR(control.Validate());
-  LIFTOFF_ASSIGN_OR_RETURN(Model model, BuildExperimentModel(description, options));
-  const Procedure procedure(model, options);
-  LiftoffRecorder recorder(model, options);
-  State state = InitialState(model, options.drop_height_m);
-  Controls controls;
-  controls.rest_length_m.resize(model.cables.size());
-  controls.hinge_angle_rad.resize(1);
-  const double end_time_s = procedure.TimeAt(procedure.step_count());
-  auto report = [&](double t_s) {
-    if (!progress) return;
-    progress({t_s, end_time_s, state.hinge_angle_rad.empty() ? 0.0 : state.hinge_angle_rad[0]});
-  };
-
-  // the steps exactly as RunExperiment takes them; reports (and the early-stop check) at
-  // sample steps, a whole number of samples apart
-  const double dt = options.engine.time_step_s;
-  const int64_t steps_per_sample = std::max<int64_t>(1, std::llround(options.sample_period_s / dt));
-  const int64_t samples_per_report = std::max<int64_t>(
-      1,
-      static_cast<int64_t>(std::ceil(control.progress_period_s / options.sample_period_s - 1e-9)));
-  const int64_t steps_per_report = steps_per_sample * samples_per_report;
-  for (int64_t step = 1; step <= procedure.step_count(); ++step) {
-    const double t_s = procedure.TimeAt(step);
-    procedure.RestLengthsAt(t_s, controls.rest_length_m);
-    controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
-    Step(model, options.engine, controls, state);
-    state.time_s = t_s;
-    if (!procedure.IsSampleStep(step)) continue;
-    recorder.Add(SampleState(model, state));
-    if (recorder.CanStop()) break;
-    if (step % steps_per_report != 0) continue;
-    report(t_s);
-    if (control.stop_once_decided) {
-      // settled: the target lifted while standing, or the standing check failed
-      const ExperimentResult so_far = recorder.Finish();
-      if (so_far.status == RunStatus::kDidNotStand || so_far.TargetLiftoffRad()) break;
-    }
-  }
-  ExperimentResult result = recorder.Finish();
-  result.steps = state.step_count;
-  report(state.time_s);
-  return result;
-}
-
-// ---------------------------------------------------------------------------------------
 // options
 
 SweepOptions::SweepOptions()

@@ -30,42 +30,6 @@
 namespace liftoff::sim {
 
 // ---------------------------------------------------------------------------------------
-// one run, with progress
-
-/// Where a run has got to.
-struct RunProgress {
-  /// Simulated time reached and the run's planned end (end of the ramp), s.
-  double time_s = 0.0;
-  double end_time_s = 0.0;
-  /// Actual hinge angle of the rotating vertebra at time_s, rad, signed.
-  double hinge_angle_rad = 0.0;
-};
-using RunProgressCallback = std::function<void(const RunProgress& progress)>;
-
-struct RunControl {
-  /// Progress is reported every this much simulated time, s (> 0; a whole number of
-  /// samples, rounded up), and once at the end.
-  double progress_period_s = 0.5;
-  /// Stop as soon as the targeted foot's outcome is settled: it lifted (so the first foot
-  /// is known too) or the robot has failed the standing check. The liftoff rule and the
-  /// standing check only look back, so the targeted foot's value, the first foot and the
-  /// status are exactly those of the full run; the curves end there, and feet that had not
-  /// lifted by then stay unlifted. Checked every progress_period_s. false: run the whole
-  /// timeline (or until ExperimentOptions::stop_after_liftoff_rad says stop).
-  bool stop_once_decided = false;
-
-  Status Validate() const;
-};
-
-/// RunExperiment with progress reports (and, optionally, the early stop of RunControl):
-/// the same steps in the same order, so the same result bit for bit when
-/// stop_once_decided is false. `progress` may be empty. Errors as RunExperiment.
-Result<ExperimentResult> RunExperimentWithProgress(const ModelDescription& description,
-                                                   const ExperimentOptions& options,
-                                                   const RunControl& control,
-                                                   const RunProgressCallback& progress);
-
-// ---------------------------------------------------------------------------------------
 // the sweep
 
 struct SweepOptions {
