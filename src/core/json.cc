@@ -89,6 +89,22 @@ Result<json> ParseJsonText(std::string_view text, std::string_view source_name) 
     if (cut != std::string::npos) what = what.substr(cut);
     return ParseError(std::string(source_name) + ":" + std::to_string(line) + ":" +
                       std::to_string(column) + ": invalid JSON: " + what);
+  } catch (const json::out_of_range& error) {
+    // a number too large for a double ("number overflow parsing '1e999'"): nlohmann gives
+    // no offset, so the literal it quotes is looked up in the text
+    std::string what = error.what();
+    const size_t cut = what.find("number overflow");
+    if (cut != std::string::npos) what = what.substr(cut);
+    std::string where = std::string(source_name);
+    const size_t open = what.find('\''), close = what.rfind('\'');
+    if (open != std::string::npos && close > open + 1) {
+      const size_t at = text.find(what.substr(open + 1, close - open - 1));
+      if (at != std::string_view::npos) {
+        const auto [line, column] = LineColumn(text, at);
+        where += ":" + std::to_string(line) + ":" + std::to_string(column);
+      }
+    }
+    return ParseError(where + ": invalid JSON: " + what);
   }
 }
 

@@ -71,6 +71,14 @@ TEST(ParseJsonText, TruncatedObjectNamesLastLine) {
   EXPECT_THAT(document.status().message(), StartsWith("t.json:3:"));
 }
 
+TEST(ParseJsonText, NumberTooLargeForADoubleIsAParseErrorWithItsPlace) {
+  const Result<json> document = ParseJsonText("{\n  \"z\": [0, 1e999]\n}", "m.json");
+  ASSERT_FALSE(document.ok());
+  EXPECT_EQ(document.status().code(), StatusCode::kParse);
+  EXPECT_THAT(document.status().message(),
+              StartsWith("m.json:2:12: invalid JSON: number overflow parsing '1e999'"));
+}
+
 TEST(WriteJsonFile, WritesIndentedJsonThatReadsBack) {
   ScratchDir dir;
   const std::filesystem::path path = dir / "out.json";

@@ -47,7 +47,7 @@
 // are referred to as "<body>/<node>", a hinge's child is driven relative to its parent
 // (parent must itself be free: no chains), and a foot letter appears at most once.
 // Errors name the file and the JSON pointer: "laika.json: /cables/3/to: unknown node
-// \"v2/tip\"; body v2 has center, top, bottom, right, left".
+// \"v2/tip\"; body v2 has bottom, center, left, right, top".
 // ---------------------------------------------------------------------------------------
 #pragma once
 
