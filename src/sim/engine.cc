@@ -201,6 +201,7 @@ void PrepareScratch(const Model& model, State& state) {
   scratch.rhs.setZero(scratch.dofs);
   scratch.velocity.setZero(scratch.dofs);
   scratch.start_velocity.setZero(scratch.dofs);
+  scratch.cable_terms.assign(model.cables.size(), CableStepTerm{});
   scratch.contacts.reserve(16);
 }
 
@@ -564,6 +565,159 @@ void SolveContacts(const EngineOptions& options, State& state, int rows) {
   }
 }
 
+// Each cable's part in the step from the start-of-step geometry and velocities.
+void PrepareCableTerms(const Model& model, const EngineOptions& options, State& state) {
+  StepScratch& scratch = state.scratch;
+  const double dt = options.time_step_s;
+  if (state.cable_tension_n.size() != model.cables.size()) {
+    state.cable_tension_n.assign(model.cables.size(), 0.0);
+  }
+  for (size_t c = 0; c < model.cables.size(); ++c) {
+    const Cable& cable = model.cables[c];
+    CableStepTerm& term = scratch.cable_terms[c];
+    term = CableStepTerm{};
+    term.cluster_a = scratch.cluster_of_body[Index(cable.body_a)];
+    term.cluster_b = scratch.cluster_of_body[Index(cable.body_b)];
+    const Vec3 pa = state.bodies[Index(cable.body_a)].position_m +
+                    scratch.rotation[Index(cable.body_a)] * cable.anchor_a_m;
+    const Vec3 pb = state.bodies[Index(cable.body_b)].position_m +
+                    scratch.rotation[Index(cable.body_b)] * cable.anchor_b_m;
+    const Vec3 u = pb - pa;
+    const double length = u.norm();
+    const double rest = state.rest_length_m[c];
+    if (!(length > rest) || length <= 0.0) continue;  // slack: exactly no force
+    const Vec3 n = u / length;
+    const Vec3 va = PointVelocity(scratch, state, cable.body_a, pa, scratch.start_velocity);
+    const Vec3 vb = PointVelocity(scratch, state, cable.body_b, pb, scratch.start_velocity);
+    term.rate_m_per_s = n.dot(vb - va);
+    term.stretch_m = length - rest;
+    term.tension_n = CableTension(length, term.rate_m_per_s, rest, cable.stiffness_n_per_m,
+                                  cable.damping_n_s_per_m, model.damping_cap);
+    term.held_tension_n = term.tension_n;
+    // inside one rigid cluster: no net effect (its tension is internal)
+    if (term.cluster_a == term.cluster_b) continue;
+    // gradient of the length rate over the two clusters' velocities
+    term.row_a = -PointRow(scratch, state, cable.body_a, pa, n);
+    term.row_b = PointRow(scratch, state, cable.body_b, pb, n);
+    const double weight = dt * cable.damping_n_s_per_m +
+                          (options.implicit_stiffness ? dt * dt * cable.stiffness_n_per_m : 0.0);
+    term.mode = weight > 0.0 ? CableStepTerm::kImplicit : CableStepTerm::kHeld;
+  }
+}
+
+// The step's system matrix (lower triangle) and right-hand side: mass matrices about each
+// cluster's origin, gravity, gyroscopic forces, cables (explicit tension, implicit damping
+// and stiffness as rank-one updates; held cables at their constant tension).
+void AssembleSystem(const Model& model, const EngineOptions& options, State& state) {
+  StepScratch& scratch = state.scratch;
+  const double dt = options.time_step_s;
+  Eigen::MatrixXd& system = scratch.system;
+  Eigen::VectorXd& rhs = scratch.rhs;
+  system.setZero();
+  rhs.setZero();
+  for (size_t k = 0; k < scratch.cluster_root.size(); ++k) {
+    const Vec3& origin = state.bodies[Index(scratch.cluster_root[k])].position_m;
+    double mass = 0.0;
+    Vec3 first_moment = Vec3::Zero();
+    Mat3 inertia = Mat3::Zero();
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      if (scratch.cluster_of_body[b] != static_cast<int>(k)) continue;
+      const Body& body = model.bodies[b];
+      const Mat3& rotation = scratch.rotation[b];
+      const Vec3 offset = state.bodies[b].position_m + rotation * body.com_m - origin;
+      mass += body.mass_kg;
+      first_moment += body.mass_kg * offset;
+      inertia +=
+          rotation * body.inertia_kg_m2 * rotation.transpose() +
+          body.mass_kg * (offset.squaredNorm() * Mat3::Identity() - offset * offset.transpose());
+    }
+    const Eigen::Index at = static_cast<Eigen::Index>(6 * k);
+    const Mat3 moment_skew = Skew(first_moment);
+    system.block<3, 3>(at, at) = mass * Mat3::Identity();
+    system.block<3, 3>(at, at + 3) = -moment_skew;
+    system.block<3, 3>(at + 3, at) = moment_skew;
+    system.block<3, 3>(at + 3, at + 3) = inertia;
+    const Vec3 w = scratch.start_velocity.segment<3>(at + 3);
+    const Vec3 force = mass * model.gravity_m_per_s2 - w.cross(w.cross(first_moment));
+    const Vec3 torque = first_moment.cross(model.gravity_m_per_s2) - w.cross(inertia * w);
+    rhs.segment<3>(at) += dt * force;
+    rhs.segment<3>(at + 3) += dt * torque;
+  }
+
+  for (size_t c = 0; c < model.cables.size(); ++c) {
+    const CableStepTerm& term = scratch.cable_terms[c];
+    if (term.mode == CableStepTerm::kNone) continue;
+    const Cable& cable = model.cables[c];
+    const Vec6& ga = term.row_a;
+    const Vec6& gb = term.row_b;
+    const Eigen::Index ia = 6 * term.cluster_a;
+    const Eigen::Index ib = 6 * term.cluster_b;
+    if (term.mode == CableStepTerm::kHeld) {
+      rhs.segment<6>(ia) -= dt * term.held_tension_n * ga;
+      rhs.segment<6>(ib) -= dt * term.held_tension_n * gb;
+      continue;
+    }
+    rhs.segment<6>(ia) -= dt * term.tension_n * ga;
+    rhs.segment<6>(ib) -= dt * term.tension_n * gb;
+    double weight = dt * cable.damping_n_s_per_m;
+    if (options.implicit_stiffness) {
+      weight += dt * dt * cable.stiffness_n_per_m;
+      // the spring's own change over the step, evaluated at the new velocity
+      rhs.segment<6>(ia) -= dt * dt * cable.stiffness_n_per_m * term.rate_m_per_s * ga;
+      rhs.segment<6>(ib) -= dt * dt * cable.stiffness_n_per_m * term.rate_m_per_s * gb;
+    }
+    // the factorisation reads the lower triangle only
+    AddLowerOuter(system, ia, ga, weight);
+    AddLowerOuter(system, ib, gb, weight);
+    if (ia > ib) {
+      AddOuter(system, ia, ib, ga, gb, weight);
+    } else {
+      AddOuter(system, ib, ia, gb, ga, weight);
+    }
+  }
+}
+
+// Each cable's tension over the step into state.cable_tension_n; an implicit cable whose
+// tension left the law's range (below 0, or above 2 k (x - r) with the damping cap) is
+// held at the bound it crossed. Returns whether any was.
+bool HoldCablesOutOfRange(const Model& model, const EngineOptions& options, State& state) {
+  StepScratch& scratch = state.scratch;
+  const double dt = options.time_step_s;
+  bool held_any = false;
+  for (size_t c = 0; c < model.cables.size(); ++c) {
+    CableStepTerm& term = scratch.cable_terms[c];
+    if (term.mode != CableStepTerm::kImplicit) {
+      state.cable_tension_n[c] = term.held_tension_n;
+      continue;
+    }
+    const Cable& cable = model.cables[c];
+    const Eigen::Index ia = 6 * term.cluster_a;
+    const Eigen::Index ib = 6 * term.cluster_b;
+    const double rate_change =
+        term.row_a.dot(scratch.velocity.segment<6>(ia) - scratch.start_velocity.segment<6>(ia)) +
+        term.row_b.dot(scratch.velocity.segment<6>(ib) - scratch.start_velocity.segment<6>(ib));
+    double spring = cable.stiffness_n_per_m * term.stretch_m;
+    double applied = term.tension_n + cable.damping_n_s_per_m * rate_change;
+    if (options.implicit_stiffness) {
+      const double spring_change = dt * cable.stiffness_n_per_m * (term.rate_m_per_s + rate_change);
+      spring += spring_change;
+      applied += spring_change;
+    }
+    state.cable_tension_n[c] = applied;
+    if (applied < 0.0) {
+      term.held_tension_n = 0.0;
+    } else if (model.damping_cap && applied > 2.0 * spring) {
+      term.held_tension_n = std::max(0.0, 2.0 * spring);
+    } else {
+      continue;
+    }
+    term.mode = CableStepTerm::kHeld;
+    state.cable_tension_n[c] = term.held_tension_n;
+    held_any = true;
+  }
+  return held_any;
+}
+
 }  // namespace
 
 Status EngineOptions::Validate() const {
@@ -614,6 +768,7 @@ State InitialState(const Model& model, double lift_m) {
   state.hinge_angle_rad.assign(model.hinges.size(), 0.0);
   state.hinge_rate_rad_per_s.assign(model.hinges.size(), 0.0);
   state.foot_normal_impulse_n_s.assign(model.feet.size(), 0.0);
+  state.cable_tension_n.assign(model.cables.size(), 0.0);
   return state;
 }
 
@@ -657,101 +812,26 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
   }
   scratch.start_velocity = scratch.velocity;
 
-  // mass matrices about each cluster's origin, gravity and gyroscopic forces
-  Eigen::MatrixXd& system = scratch.system;
-  Eigen::VectorXd& rhs = scratch.rhs;
-  system.setZero();
-  rhs.setZero();
-  for (size_t k = 0; k < scratch.cluster_root.size(); ++k) {
-    const Vec3& origin = state.bodies[Index(scratch.cluster_root[k])].position_m;
-    double mass = 0.0;
-    Vec3 first_moment = Vec3::Zero();
-    Mat3 inertia = Mat3::Zero();
-    for (size_t b = 0; b < model.bodies.size(); ++b) {
-      if (scratch.cluster_of_body[b] != static_cast<int>(k)) continue;
-      const Body& body = model.bodies[b];
-      const Mat3& rotation = scratch.rotation[b];
-      const Vec3 offset = state.bodies[b].position_m + rotation * body.com_m - origin;
-      mass += body.mass_kg;
-      first_moment += body.mass_kg * offset;
-      inertia +=
-          rotation * body.inertia_kg_m2 * rotation.transpose() +
-          body.mass_kg * (offset.squaredNorm() * Mat3::Identity() - offset * offset.transpose());
-    }
-    const Eigen::Index at = static_cast<Eigen::Index>(6 * k);
-    const Mat3 moment_skew = Skew(first_moment);
-    system.block<3, 3>(at, at) = mass * Mat3::Identity();
-    system.block<3, 3>(at, at + 3) = -moment_skew;
-    system.block<3, 3>(at + 3, at) = moment_skew;
-    system.block<3, 3>(at + 3, at + 3) = inertia;
-    const Vec3 w = scratch.velocity.segment<3>(at + 3);
-    const Vec3 force = mass * model.gravity_m_per_s2 - w.cross(w.cross(first_moment));
-    const Vec3 torque = first_moment.cross(model.gravity_m_per_s2) - w.cross(inertia * w);
-    rhs.segment<3>(at) += dt * force;
-    rhs.segment<3>(at + 3) += dt * torque;
-  }
+  PrepareCableTerms(model, options, state);
 
-  // cables: explicit tension, implicit damping (and stiffness) as rank-one updates
-  for (size_t c = 0; c < model.cables.size(); ++c) {
-    const Cable& cable = model.cables[c];
-    const int cluster_a = scratch.cluster_of_body[Index(cable.body_a)];
-    const int cluster_b = scratch.cluster_of_body[Index(cable.body_b)];
-    if (cluster_a == cluster_b) continue;  // inside one rigid cluster: no net effect
-    const Vec3 pa = state.bodies[Index(cable.body_a)].position_m +
-                    scratch.rotation[Index(cable.body_a)] * cable.anchor_a_m;
-    const Vec3 pb = state.bodies[Index(cable.body_b)].position_m +
-                    scratch.rotation[Index(cable.body_b)] * cable.anchor_b_m;
-    const Vec3 u = pb - pa;
-    const double length = u.norm();
-    const double rest = state.rest_length_m[c];
-    if (!(length > rest) || length <= 0.0) continue;  // slack: exactly no force
-    const Vec3 n = u / length;
-    const Vec3 va = PointVelocity(scratch, state, cable.body_a, pa, scratch.velocity);
-    const Vec3 vb = PointVelocity(scratch, state, cable.body_b, pb, scratch.velocity);
-    const double rate = n.dot(vb - va);
-    const double tension = CableTension(length, rate, rest, cable.stiffness_n_per_m,
-                                        cable.damping_n_s_per_m, model.damping_cap);
-    // g: gradient of the length rate over the two clusters' velocities
-    const Vec6 ga = -PointRow(scratch, state, cable.body_a, pa, n);
-    const Vec6 gb = PointRow(scratch, state, cable.body_b, pb, n);
-    const Eigen::Index ia = 6 * cluster_a;
-    const Eigen::Index ib = 6 * cluster_b;
-    rhs.segment<6>(ia) -= dt * tension * ga;
-    rhs.segment<6>(ib) -= dt * tension * gb;
-    double weight = dt * cable.damping_n_s_per_m;
-    if (options.implicit_stiffness) {
-      weight += dt * dt * cable.stiffness_n_per_m;
-      // the spring's own change over the step, evaluated at the new velocity
-      rhs.segment<6>(ia) -= dt * dt * cable.stiffness_n_per_m * rate * ga;
-      rhs.segment<6>(ib) -= dt * dt * cable.stiffness_n_per_m * rate * gb;
-    }
-    if (weight > 0.0) {
-      // the factorisation reads the lower triangle only
-      AddLowerOuter(system, ia, ga, weight);
-      AddLowerOuter(system, ib, gb, weight);
-      if (ia > ib) {
-        AddOuter(system, ia, ib, ga, gb, weight);
-      } else {
-        AddOuter(system, ib, ia, gb, ga, weight);
-      }
-    }
-  }
-
-  // velocities without contact
-  // contacts at the start of the step, then one solve for the free velocity change and
-  // for A^-1 J^T
+  // contacts at the start of the step; then the velocities: one solve for the free
+  // velocity change and for A^-1 J^T, then the contact impulses; again while a cable's
+  // tension over the step leaves the law's range (held at the bound from then on)
   FindContacts(model, options, state);
   const int rows = BuildContactRows(model, options, state);
-  const bool positive_definite = BandCholesky(system, scratch.band);
-  assert(positive_definite && "the step's system matrix must be positive definite");
-  (void)positive_definite;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& solution =
-      scratch.solution;
-  solution.col(0) = rhs;
-  solution.middleCols(1, rows) = scratch.contact_jacobian.topRows(rows).transpose();
-  BandSolveColumns(system, scratch.band, solution.data(), solution.cols(), rows + 1);
-  scratch.velocity += solution.col(0);
-  SolveContacts(options, state, rows);
+  do {
+    AssembleSystem(model, options, state);
+    const bool positive_definite = BandCholesky(scratch.system, scratch.band);
+    assert(positive_definite && "the step's system matrix must be positive definite");
+    (void)positive_definite;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& solution =
+        scratch.solution;
+    solution.col(0) = scratch.rhs;
+    solution.middleCols(1, rows) = scratch.contact_jacobian.topRows(rows).transpose();
+    BandSolveColumns(scratch.system, scratch.band, solution.data(), solution.cols(), rows + 1);
+    scratch.velocity = scratch.start_velocity + solution.col(0);
+    SolveContacts(options, state, rows);
+  } while (HoldCablesOutOfRange(model, options, state));
 
   // positions from the new velocities
   for (size_t k = 0; k < scratch.cluster_root.size(); ++k) {
@@ -899,6 +979,7 @@ uint64_t StateHash(const State& state) {
   for (double value : state.hinge_angle_rad) mix(value);
   for (double value : state.hinge_rate_rad_per_s) mix(value);
   for (double value : state.foot_normal_impulse_n_s) mix(value);
+  for (double value : state.cable_tension_n) mix(value);
   for (int64_t key : state.warm_contact_key) mix_bytes(&key, sizeof(key));
   for (double value : state.warm_contact_impulse_n_s) mix(value);
   return hash;

@@ -1,6 +1,7 @@
 #include "liftoff/sim/engine.h"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -252,6 +253,164 @@ TEST(Engine, HingeChildFollowsTheCommandedAngle) {
                      (hinge.point_m + hinge.axis - hinge.child_position_in_parent_m));
   EXPECT_LT((on_axis_parent - on_axis_child).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(state.hinge_angle_rad[0], 0.3);
+}
+
+// The review's two-cable toy: a 0.1 kg bob at the origin (z 1 m), cable A to a fixed
+// anchor at x = -0.5 m barely taut (k 100 N/m, c 10 N*s/m, 1e-4 N: 1e-6 m of stretch),
+// cable B (k 1000 N/m, no damping) pulling the bob with 100 N towards A's anchor
+// (`b_towards_a`: A shortens, an implicit damper would push) or away from it (A lengthens
+// fast, an implicit damper would exceed the cap 2 k (x - r) = 2e-4 N).
+ModelDescription TwoCables(bool b_towards_a) {
+  ModelDescription model;
+  model.name = "two_cables";
+  model.gravity_m_per_s2 = Vec3::Zero();
+  model.cable_attachment = CableAttachment::kNode;
+  const double bob_radius = 0.02;
+  const double bob_density = 0.1 / (4.0 / 3.0 * kPi * std::pow(bob_radius, 3));
+  model.bodies.push_back(SphereBody("near", Vec3(-0.5, 0.0, 1.0), 0.05, 1e12));
+  model.bodies.push_back(SphereBody("far", Vec3(b_towards_a ? -1.0 : 0.5, 0.0, 1.0), 0.05, 1e12));
+  model.bodies.push_back(SphereBody("bob", Vec3(0.0, 0.0, 1.0), bob_radius, bob_density));
+  model.cable_groups.push_back({"A", "test", 100.0, 10.0, 1e-4});
+  model.cable_groups.push_back({"B", "test", 1000.0, 0.0, 100.0});
+  model.cables.push_back({"a", "A", "near", "c", "bob", "c"});
+  model.cables.push_back({"b", "B", "far", "c", "bob", "c"});
+  return model;
+}
+
+TEST(Engine, ImplicitDampingNeverMakesACablePushOrExceedTheCap) {
+  // A's tension over one step from the bob's momentum: m dv / dt = F_B + F_A along x, with
+  // F_A = -T_A (A pulls towards -x) and F_B = -+T_B, B having no damping: T_B = 100 N, or
+  // with implicit stiffness its spring at the end of the step, 100 N + dt k_B x'_B. The law
+  // allows 0 <= T_A <= 2 k (x - r) (x - r = 1e-6 m, or with implicit stiffness its value at
+  // the end of the step, 1e-6 m + dt x'_A). The linearly implicit damper alone gave
+  // T_A = -33.3 N (dt 5 ms) and -45.5 N (1 ms) shortening, +33.3 N lengthening.
+  for (bool towards : {true, false}) {
+    const Result<Model> model = BuildModel(TwoCables(towards));
+    ASSERT_TRUE(model.ok()) << model.status().ToString();
+    const double mass = model->bodies[2].mass_kg;
+    ASSERT_NEAR(mass, 0.1, 1e-12);
+    for (bool implicit_stiffness : {false, true}) {
+      for (double dt : {0.005, 0.001}) {
+        SCOPED_TRACE(testing::Message() << (towards ? "shortening" : "lengthening") << ", dt " << dt
+                                        << ", implicit stiffness " << implicit_stiffness);
+        State state = InitialState(*model);
+        ASSERT_NEAR(ReadCable(*model, state, 0).tension_n, 1e-4, 1e-9);
+        ASSERT_NEAR(ReadCable(*model, state, 1).tension_n, 100.0, 1e-9);
+        EngineOptions options;
+        options.time_step_s = dt;
+        options.implicit_stiffness = implicit_stiffness;
+        Step(*model, options, {}, state);
+        const double v = state.bodies[2].velocity_m_per_s.x();
+        // rates of lengthening: A runs from x = -0.5 to the bob, B from its anchor to the bob
+        const double rate_a = v;
+        const double rate_b = towards ? v : -v;
+        const double tension_b = 100.0 + (implicit_stiffness ? dt * 1000.0 * rate_b : 0.0);
+        const double force_b = towards ? -tension_b : tension_b;
+        const double tension_a = force_b - mass * v / dt;
+        const double cap = 2.0 * 100.0 * (1e-6 + (implicit_stiffness ? dt * rate_a : 0.0));
+        // (tolerance: the 5e8 kg anchors move by ~1e-9 m/s)
+        EXPECT_GE(tension_a, -1e-7);
+        EXPECT_LE(tension_a, std::max(0.0, cap) + 1e-7);
+        // the reported tension is the one applied
+        EXPECT_NEAR(state.cable_tension_n[0], tension_a, 1e-7);
+        EXPECT_NEAR(state.cable_tension_n[1], tension_b, 1e-7);
+        EXPECT_GE(state.cable_tension_n[0], 0.0);
+      }
+    }
+  }
+}
+
+// `poses` with its cluster roots moving at the velocities of `velocities` and each hinge
+// child carried by its parent at `velocities`' hinge rate (the engine's kinematics).
+State WithVelocities(const Model& model, const State& poses, const State& root_velocities,
+                     const std::vector<double>& hinge_rate_rad_per_s) {
+  State mixed = poses;
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    if (model.bodies[b].driving_hinge >= 0) continue;
+    mixed.bodies[b].velocity_m_per_s = root_velocities.bodies[b].velocity_m_per_s;
+    mixed.bodies[b].angular_velocity_rad_per_s =
+        root_velocities.bodies[b].angular_velocity_rad_per_s;
+  }
+  for (size_t h = 0; h < model.hinges.size(); ++h) {
+    const Hinge& hinge = model.hinges[h];
+    const BodyState& parent = mixed.bodies[static_cast<size_t>(hinge.parent)];
+    BodyState& child = mixed.bodies[static_cast<size_t>(hinge.child)];
+    const Vec3 axis = parent.orientation * hinge.axis;
+    const Vec3 on_axis = parent.position_m + parent.orientation * hinge.point_m;
+    const double rate = hinge_rate_rad_per_s[h];
+    child.angular_velocity_rad_per_s = parent.angular_velocity_rad_per_s + rate * axis;
+    child.velocity_m_per_s =
+        parent.velocity_m_per_s +
+        parent.angular_velocity_rad_per_s.cross(child.position_m - parent.position_m) +
+        rate * axis.cross(child.position_m - on_axis);
+  }
+  return mixed;
+}
+
+TEST(Engine, LaikaCablesNeverPushOverARun) {
+  // the experiment's steps at the default 5 ms (drop, settle, bend, the ramp past the
+  // liftoff), mean tension point: each cable's tension over each step is within the law's
+  // range, and for a cable the engine treated implicitly it is the law's value at the new
+  // velocities, T + c (x'+ - x') with x' from the start-of-step geometry (so the impulse the
+  // cable applied never implies a push)
+  const Result<ModelDescription> description = LoadModelDescription(DefaultModelPath());
+  ASSERT_TRUE(description.ok()) << description.status().ToString();
+  ExperimentOptions options;
+  options.foot = Foot::kA;
+  options.tension_point_index = 2;
+  const Result<Model> built = BuildExperimentModel(*description, options);
+  ASSERT_TRUE(built.ok()) << built.status().ToString();
+  const Model& model = *built;
+  ASSERT_TRUE(model.damping_cap);
+  const Procedure procedure(model, options);
+  State state = InitialState(model, options.drop_height_m);
+  Controls controls;
+  controls.rest_length_m.resize(model.cables.size());
+  controls.hinge_angle_rad.resize(1);
+  int64_t taut = 0;
+  int64_t at_bound = 0;
+  double worst_mismatch = 0.0;
+  for (int64_t step = 1; step <= procedure.step_count(); ++step) {
+    const double t_s = procedure.TimeAt(step);
+    procedure.RestLengthsAt(t_s, controls.rest_length_m);
+    controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
+    State before = state;
+    before.rest_length_m = controls.rest_length_m;
+    Step(model, options.engine, controls, state);
+    const State start = WithVelocities(model, before, before, state.hinge_rate_rad_per_s);
+    const State end = WithVelocities(model, before, state, state.hinge_rate_rad_per_s);
+    for (size_t c = 0; c < model.cables.size(); ++c) {
+      const Cable& cable = model.cables[c];
+      const int index = static_cast<int>(c);
+      const CableReading at_start = ReadCable(model, start, index);
+      const CableReading at_end = ReadCable(model, end, index);
+      const double applied = state.cable_tension_n[c];
+      const double stretch = at_start.length_m - controls.rest_length_m[c];
+      if (!(stretch > 0.0)) {
+        ASSERT_EQ(applied, 0.0) << cable.name << " at " << t_s << " s";
+        continue;
+      }
+      ++taut;
+      const double cap = 2.0 * cable.stiffness_n_per_m * stretch;
+      ASSERT_GE(applied, 0.0) << cable.name << " at " << t_s << " s";
+      ASSERT_LE(applied, cap + 1e-9) << cable.name << " at " << t_s << " s";
+      if (applied == 0.0 || applied >= cap - 1e-9) {
+        ++at_bound;  // held at a bound (or exactly on it)
+        continue;
+      }
+      const double implied =
+          at_start.tension_n +
+          cable.damping_n_s_per_m * (at_end.length_rate_m_per_s - at_start.length_rate_m_per_s);
+      worst_mismatch = std::max(worst_mismatch, std::abs(applied - implied));
+      ASSERT_NEAR(applied, implied, 1e-6 * (1.0 + std::abs(implied)))
+          << cable.name << " at " << t_s << " s";
+    }
+  }
+  EXPECT_GT(taut, 100000);
+  // the run does reach the bounds (cables going slack in the drop and after the liftoff)
+  EXPECT_GT(at_bound, 0);
+  std::printf("taut cable-steps %lld, at a bound %lld, worst mismatch %.3g N\n",
+              static_cast<long long>(taut), static_cast<long long>(at_bound), worst_mismatch);
 }
 
 // Laika built at a tension point with the experiment's rule, settled for `settle_s`.

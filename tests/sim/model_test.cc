@@ -52,6 +52,69 @@ TEST(Model, BundledLaikaHasTheDocumentedParts) {
   for (Foot f : kAllFeet) EXPECT_NEAR(foot(f).z(), 0.0, 1e-12) << FootName(f);
 }
 
+TEST(Model, EveryCableJoinsTheDocumentedNodes) {
+  // independent table: gap g (1..4) joins vertebra g - 1 (from) to vertebra g (to), in the
+  // order rear, v2, v3, v4, front; horizontal cables join like nodes, saddle cables run
+  // from the forward tip (top or bottom) to the back tip (right or left) of the next
+  // vertebra; on v3, top and bottom belong to v3b, right and left to v3a. Nodes in the
+  // body frame (x forward, y to the left): tips 0.065 m forward or back of the centre,
+  // 0.096 m out.
+  struct Ends {
+    const char* group;
+    const char* from_node;
+    const char* to_node;
+  };
+  const Ends table[] = {{"HT", "top", "top"},       {"HB", "bottom", "bottom"},
+                        {"HR", "right", "right"},   {"HL", "left", "left"},
+                        {"STR", "top", "right"},    {"STL", "top", "left"},
+                        {"SBR", "bottom", "right"}, {"SBL", "bottom", "left"}};
+  const char* vertebrae[] = {"rear", "v2", "v3", "v4", "front"};
+  const auto body_of = [](const std::string& vertebra, const std::string& node) {
+    if (vertebra != "v3") return vertebra;
+    return std::string(node == "top" || node == "bottom" ? "v3b" : "v3a");
+  };
+  const auto node_at = [](const std::string& node) {
+    if (node == "top") return Vec3(0.065, 0.0, 0.096);
+    if (node == "bottom") return Vec3(0.065, 0.0, -0.096);
+    if (node == "right") return Vec3(-0.065, -0.096, 0.0);
+    return Vec3(-0.065, 0.096, 0.0);  // left
+  };
+  const Result<ModelDescription> description = LoadModelDescription(DefaultModelPath());
+  ASSERT_TRUE(description.ok()) << description.status().ToString();
+  const Model model = LoadLaika();
+  ASSERT_EQ(model.cables.size(), 32u);
+  ASSERT_EQ(description->cables.size(), 32u);
+  int checked = 0;
+  for (const Ends& ends : table) {
+    for (int gap = 1; gap <= 4; ++gap) {
+      const std::string name = std::string(ends.group) + std::to_string(gap);
+      SCOPED_TRACE(name);
+      const std::string from_body = body_of(vertebrae[gap - 1], ends.from_node);
+      const std::string to_body = body_of(vertebrae[gap], ends.to_node);
+      int found = 0;
+      for (size_t c = 0; c < model.cables.size(); ++c) {
+        const Cable& cable = model.cables[c];
+        if (cable.name != name) continue;
+        ++found;
+        EXPECT_EQ(model.cable_groups[static_cast<size_t>(cable.group)].name, ends.group);
+        EXPECT_EQ(cable.body_a, model.BodyIndex(from_body));
+        EXPECT_EQ(cable.body_b, model.BodyIndex(to_body));
+        EXPECT_LT((cable.node_a_m - node_at(ends.from_node)).norm(), 1e-12);
+        EXPECT_LT((cable.node_b_m - node_at(ends.to_node)).norm(), 1e-12);
+        const CableDescription& written = description->cables[c];
+        EXPECT_EQ(written.name, name);
+        EXPECT_EQ(written.from_body, from_body);
+        EXPECT_EQ(written.from_node, ends.from_node);
+        EXPECT_EQ(written.to_body, to_body);
+        EXPECT_EQ(written.to_node, ends.to_node);
+      }
+      EXPECT_EQ(found, 1);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 32);
+}
+
 TEST(Model, MassesMatchTheReferenceTable) {
   const Model model = LoadLaika();
   // by hand: solid cylinders pi r^2 L rho, boxes and spheres

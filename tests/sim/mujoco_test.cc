@@ -231,6 +231,9 @@ TEST(MujocoCrossCheck, LiftoffRotationsAgreeWithLiftoffsEngineAtEveryStandingPoi
     std::string difference = "-";
     const auto ours_rad = ours.TargetLiftoffRad();
     const auto theirs_rad = theirs.TargetLiftoffRad();
+    // the standing verdict agrees both ways
+    EXPECT_EQ(theirs.status == RunStatus::kDidNotStand, ours.status == RunStatus::kDidNotStand)
+        << ours.Brief() << " | " << theirs.Brief();
     if (ours.status != RunStatus::kDidNotStand) {
       // where liftoff's robot stands, MuJoCo's must too and lift the same foot first
       EXPECT_EQ(RunStatusName(theirs.status), RunStatusName(ours.status))

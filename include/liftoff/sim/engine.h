@@ -7,7 +7,13 @@
 //   2. velocities, linearly implicit in the cable damping (and, as an option, stiffness):
 //      (M - dt D - dt^2 K) (v+ - v) = dt f, with D = df/dv and K = df/dq of the cables
 //      (Baraff-Witkin); without damping and with K off this is exactly symplectic Euler,
-//      so an undamped spring keeps its energy;
+//      so an undamped spring keeps its energy. A cable taut at the start applies over the
+//      step T + c (x'+ - x') (+ dt k x'+ with implicit stiffness), x'+ its rate at the new
+//      velocities; the law allows only 0 .. 2 k (x - r) (with the cap; else >= 0), so after
+//      steps 2 and 3 a cable whose applied tension left that range is held at the bound it
+//      crossed (explicit, constant over the step) and steps 2 and 3 are solved again, until
+//      none leaves it (held cables stay held: at most one pass more per cable; in practice
+//      a second pass in a few steps of a run, while cables go slack);
 //   3. contacts: velocity-level impulses on top of step 2 through the same matrix
 //      (restitution r: the normal velocity leaves at >= r times its arrival speed; 0 by
 //      default), Coulomb friction in a circular cone, penetration removed by a bias of
@@ -90,6 +96,24 @@ struct ContactPoint {
   double target_normal_velocity_m_per_s = 0.0;
 };
 
+/// One cable's part in a step (scratch of Step).
+struct CableStepTerm {
+  enum Mode { kNone, kImplicit, kHeld };
+  /// kNone: slack, or inside one rigid cluster (no net force); kImplicit: in the system
+  /// matrix; kHeld: a constant tension `held_tension_n` on the right-hand side.
+  Mode mode = kNone;
+  int cluster_a = 0;
+  int cluster_b = 0;
+  /// d(length rate)/d(velocities of cluster a and of cluster b).
+  Eigen::Matrix<double, 6, 1> row_a = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> row_b = Eigen::Matrix<double, 6, 1>::Zero();
+  /// At the start of the step: tension, N, length rate, m/s, and stretch x - r, m.
+  double tension_n = 0.0;
+  double rate_m_per_s = 0.0;
+  double stretch_m = 0.0;
+  double held_tension_n = 0.0;
+};
+
 /// Scratch buffers of Step (not part of the physical state; never hashed). Sized on the
 /// first step and grown only when more contacts appear than ever before; copying a State
 /// copies them (harmless).
@@ -112,9 +136,10 @@ struct StepScratch {
   Eigen::MatrixXd contact_jacobian;  // rows x dofs (capacity)
   // dofs x (1 + rows) (capacity), row-major: the free velocity change, then A^-1 J^T
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> solution;
-  Eigen::MatrixXd delassus;         // rows x rows (capacity)
-  Eigen::VectorXd row_velocity;     // rows
-  Eigen::VectorXd contact_impulse;  // rows
+  std::vector<CableStepTerm> cable_terms;  // per cable
+  Eigen::MatrixXd delassus;                // rows x rows (capacity)
+  Eigen::VectorXd row_velocity;            // rows
+  Eigen::VectorXd contact_impulse;         // rows
 };
 
 /// Everything that changes during a run.
@@ -131,6 +156,9 @@ struct State {
   std::vector<double> hinge_rate_rad_per_s;
   /// Normal impulse of each foot's ground contact over the last step, N*s (0: no contact).
   std::vector<double> foot_normal_impulse_n_s;
+  /// Tension each cable applied over the last step (its impulse / dt), N: within the
+  /// law's range (>= 0, and <= 2 k (x - r) with the damping cap); 0 while slack.
+  std::vector<double> cable_tension_n;
   /// Contact impulses of the last step by contact key (warm start of the next step): per
   /// contact its key, and three impulses (normal, two tangents), N*s.
   std::vector<int64_t> warm_contact_key;
@@ -188,7 +216,8 @@ double KineticEnergy(const Model& model, const State& state);
 double PotentialEnergy(const Model& model, const State& state);
 
 /// FNV-1a hash of the physical state's bytes (time, poses, velocities, rest lengths,
-/// hinge angles and rates, warm-start impulses); scratch excluded. Equal states give
+/// hinge angles and rates, foot and cable diagnostics of the last step, warm-start
+/// impulses); scratch excluded. Equal states give
 /// equal hashes; any bit of difference almost surely changes it.
 uint64_t StateHash(const State& state);
 

@@ -189,8 +189,10 @@ State MujocoSimulation::Snapshot() const {
     body.position_m = Vec3(d->xpos[3 * id], d->xpos[3 * id + 1], d->xpos[3 * id + 2]);
     body.orientation =
         Quat(d->xquat[4 * id], d->xquat[4 * id + 1], d->xquat[4 * id + 2], d->xquat[4 * id + 3]);
-    mjtNum velocity[6];  // rotation then translation, world axes, at the body frame
-    mj_objectVelocity(m, d, mjOBJ_BODY, id, velocity, 0);
+    // rotation then translation, world axes, at the body frame's origin (mjOBJ_BODY would
+    // give the translation at the centre of mass)
+    mjtNum velocity[6];
+    mj_objectVelocity(m, d, mjOBJ_XBODY, id, velocity, 0);
     body.angular_velocity_rad_per_s = Vec3(velocity[0], velocity[1], velocity[2]);
     body.velocity_m_per_s = Vec3(velocity[3], velocity[4], velocity[5]);
   }
