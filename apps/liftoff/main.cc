@@ -279,10 +279,14 @@ int main(int argc, char** argv) {
       video_app
           ->add_option("--threshold-mm", video.threshold_mm, "Liftoff threshold above rest, mm")
           ->capture_default_str();
-  video_app->add_option("--threshold-px", video.threshold_px, "Liftoff threshold above rest, px")
+  video_app
+      ->add_option("--threshold-px", video.threshold_px,
+                   "Liftoff threshold above rest, px (> 0; instead of --threshold-mm)")
       ->excludes(threshold_mm);
   video_app->add_option("--exposure-ms", video.exposure_ms,
-                        "Camera exposure per frame, ms (default: the frame interval)");
+                        "Camera exposure per frame, ms, at most the frame interval (default 0: "
+                        "unknown; the LED then allows any exposure up to the frame interval, "
+                        "the foot takes half the frame interval)");
   video_app
       ->add_option(
           "--rest-window", video.rest_window,

@@ -72,13 +72,16 @@ Result<video::ClipAnalysisOptions> ClipOptionsFrom(const VideoCommand& command) 
       CheckNumberFlag("--px-per-mm", command.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
   LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-mm", command.threshold_mm,
                                           {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
-  LIFTOFF_RETURN_IF_ERROR(
-      CheckNumberFlag("--threshold-px", command.threshold_px, {.min = 0.0, .max = 1000.0}, "px"));
+  if (command.threshold_px) {
+    LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-px", *command.threshold_px,
+                                            {.min = 0.0, .max = 1000.0, .min_exclusive = true},
+                                            "px"));
+  }
   LIFTOFF_RETURN_IF_ERROR(
       CheckNumberFlag("--exposure-ms", command.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
   options.foot.px_per_mm = command.px_per_mm;
   options.foot.threshold_mm = command.threshold_mm;
-  options.foot.threshold_px = command.threshold_px;
+  options.foot.threshold_px = command.threshold_px.value_or(0.0);
   options.led.exposure_s = 1e-3 * command.exposure_ms;
   options.foot.exposure_s = options.led.exposure_s;
   LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(command.rest_window));

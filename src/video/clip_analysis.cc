@@ -15,21 +15,27 @@
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "video_util.h"
 
 namespace liftoff::video {
 namespace {
 
+using internal::Milliseconds;
+
 using nlohmann::json;
 
 constexpr NumberRange kRestOffsetRange{.min = -60.0, .max = 60.0};
+// the longest exposure accepted, in median frame intervals (timestamps rounded to 1 ms)
+constexpr double kMaxExposureIntervals = 1.05;
 
-// the frames of one clip, streamed to the detectors; remembers the times the rest
-// window rule needs (8 bytes a frame)
+// the frames of one clip, streamed to the detectors (the foot tracker's samples are the
+// only per-frame state kept)
 class ClipPass {
  public:
-  ClipPass(const ClipAnalysisOptions& options, const std::filesystem::path& path)
+  ClipPass(const ClipAnalysisOptions& options, const FootTracker::Options& foot,
+           const std::filesystem::path& path)
       : path_(path), led_(options.led) {
-    if (!options.foot.foot_roi_px.empty()) foot_.emplace(options.foot);
+    if (!foot.foot_roi_px.empty()) foot_.emplace(foot);
   }
 
   Status Process(const Frame& frame) {
@@ -38,20 +44,17 @@ class ClipPass {
     if (foot_) {
       Status foot = foot_->Process(frame);
       if (!foot.ok()) return foot.WithContext(DisplayPath(path_));
-      frame_times_ns_.push_back(frame.t_ns);
     }
     return Status::Ok();
   }
 
   LedDetector& led() { return led_; }
   std::optional<FootTracker>& foot() { return foot_; }
-  const std::vector<int64_t>& frame_times_ns() const { return frame_times_ns_; }
 
  private:
   const std::filesystem::path& path_;
   LedDetector led_;
   std::optional<FootTracker> foot_;
-  std::vector<int64_t> frame_times_ns_;
 };
 
 // Decoded frames travel from the decoding thread to the analysing one through `ready`;
@@ -195,18 +198,19 @@ struct RestWindow {
 };
 
 RestWindow ChooseRestWindow(const ClipAnalysisOptions& options, int64_t led_on_ns,
-                            const std::vector<int64_t>& frame_times_ns) {
+                            const std::vector<HeightSample>& samples) {
   RestWindow window;
   window.from_ns = led_on_ns + NsFromSeconds(options.rest_from_led_s);
   window.to_ns = led_on_ns + NsFromSeconds(options.rest_to_led_s);
-  const auto first = std::lower_bound(frame_times_ns.begin(), frame_times_ns.end(), window.from_ns);
-  const auto last = std::lower_bound(first, frame_times_ns.end(), window.to_ns);
+  const auto before = [](const HeightSample& sample, int64_t t_ns) { return sample.t_ns < t_ns; };
+  const auto first = std::lower_bound(samples.begin(), samples.end(), window.from_ns, before);
+  const auto last = std::lower_bound(first, samples.end(), window.to_ns, before);
   window.frames = last - first;
   const auto wanted = static_cast<int64_t>(options.rest_min_frames);
   if (window.frames >= wanted) return window;
 
   // too few frames: the first `wanted` frames from the window's start (all there are)
-  const int64_t available = frame_times_ns.end() - first;
+  const int64_t available = samples.end() - first;
   if (available == 0) {
     window.warning = "rest window " + FormatSeconds(window.from_ns) + "-" +
                      FormatSeconds(window.to_ns) + " s holds no frame";
@@ -214,7 +218,7 @@ RestWindow ChooseRestWindow(const ClipAnalysisOptions& options, int64_t led_on_n
   }
   const int64_t taken = std::min(wanted, available);
   const int64_t old_to_ns = window.to_ns;
-  window.to_ns = *(first + (taken - 1)) + 1;
+  window.to_ns = (first + (taken - 1))->t_ns + 1;
   window.warning = "rest window extended to " + FormatSeconds(window.to_ns) + " s (from " +
                    FormatSeconds(old_to_ns) + " s) to hold " + Plural(taken, "frame") +
                    "; it held " + Plural(window.frames, "frame");
@@ -257,17 +261,15 @@ json TimingJson(const FrameTimingReport& timing) {
           {"first_s", SecondsFromNs(timing.first_ns)},
           {"last_s", SecondsFromNs(timing.last_ns)},
           {"median_interval_ms", 1e3 * median_s},
-          {"fps", median_s > 0 ? json(1.0 / median_s) : json()},
+          {"fps", timing.fps > 0 ? json(timing.fps) : json()},
+          {"codec", timing.codec_fourcc},
+          {"lossless_codec", timing.lossless_codec},
           {"dropped_frames", timing.dropped_frames},
           {"repaired_frames", timing.repaired_frames},
           {"irregular_frames", timing.irregular_frames},
           {"container_fps", timing.container_fps},
           {"container_frames", timing.container_frames},
           {"irregularities", irregularities}};
-}
-
-std::string Milliseconds(int64_t ns) {
-  return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
 }
 
 }  // namespace
@@ -430,8 +432,11 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
   const int64_t started_ns = MonotonicNowNs();
   LIFTOFF_ASSIGN_OR_RETURN(VideoReader reader, VideoReader::Open(path, options.reader));
 
-  // one pass: every frame to the LED detector and the foot tracker
-  ClipPass pass(options, path);
+  // one pass: every frame to the LED detector and the foot tracker (no codec lag to allow
+  // for in a lossless clip)
+  FootTracker::Options foot_options = options.foot;
+  if (reader.timing().lossless_codec) foot_options.compression_error_px = 0.0;
+  ClipPass pass(options, foot_options, path);
   LIFTOFF_RETURN_IF_ERROR(RunPass(reader, pass, options.queue_frames, progress));
 
   ClipAnalysis analysis;
@@ -441,6 +446,19 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
   analysis.timing = reader.timing();
   analysis.liftoff_instant = options.liftoff;
   const FrameTimingReport& timing = analysis.timing;
+
+  // a frame's exposure cannot outlast its interval (5 % allowed for timestamp rounding)
+  const double interval_s = SecondsFromNs(timing.median_interval_ns);
+  for (const auto& [field, exposure_s] :
+       {std::pair<const char*, double>{"led.exposure_s", options.led.exposure_s},
+        {"foot.exposure_s", options.foot.exposure_s}}) {
+    if (interval_s > 0 && exposure_s > kMaxExposureIntervals * interval_s) {
+      return InvalidArgumentError(
+          DisplayPath(path) + ": " + field + " (--exposure-ms): the exposure " +
+          FormatFixed(1e3 * exposure_s, 2) + " ms is longer than the frame interval " +
+          FormatFixed(1e3 * interval_s, 2) + " ms (median)");
+    }
+  }
   if (timing.dropped_frames > 0) {
     analysis.warnings.push_back("frames: " + Plural(timing.dropped_frames, "frame") +
                                 " dropped (timestamps jump); times are the file's own");
@@ -463,14 +481,13 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
         " in the clip; the first is the sync instant");
   }
   if (std::optional<FootTracker>& foot = pass.foot()) {
-    const RestWindow rest =
-        ChooseRestWindow(options, analysis.led_on().on_ns, pass.frame_times_ns());
+    const RestWindow rest = ChooseRestWindow(options, analysis.led_on().on_ns, foot->samples());
     if (!rest.warning.empty()) analysis.warnings.push_back(rest.warning);
     analysis.rest_from_ns = rest.from_ns;
     analysis.rest_to_ns = rest.to_ns;
     analysis.rest_frames = rest.frames;
     foot->SetRestWindow(rest.from_ns, rest.to_ns);
-    Result<FootTrack> track = foot->Finish();
+    Result<FootTrack> track = std::move(*foot).Finish();
     if (!track.ok()) return track.status().WithContext(DisplayPath(path));
     analysis.foot = std::move(track).value();
     for (const std::string& warning : analysis.foot->warnings) {

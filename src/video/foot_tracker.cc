@@ -13,9 +13,14 @@
 #include <opencv2/core.hpp>
 
 #include "liftoff/core/text.h"
+#include "liftoff/core/time.h"
+#include "video_util.h"
 
 namespace liftoff::video {
 namespace {
+
+using internal::MedianOf;
+using internal::RectText;
 
 // Search radius around the previous frame's shift, px (the foot and the shake move less
 // than this between two frames); beyond it a full search runs.
@@ -31,6 +36,8 @@ constexpr double kTemplateBottomMarginPx = 2.0;
 constexpr double kRetryQuality = 0.6;
 // Scale uncertainty assumed for an estimated px_per_mm (a fraction).
 constexpr double kEstimatedScaleFraction = 0.03;
+// A located foot wider than this fraction of its region draws a warning.
+constexpr double kWideFootFraction = 0.8;
 // The hinge is fitted up to where the foot is this many thresholds above rest: far enough
 // to average over a codec's stepwise updates of slow sub-pixel motion (H.264 lets the
 // decoded foot lag by up to ~0.4 px, then catch up, every ~10 frames).
@@ -41,14 +48,6 @@ int Floor(double value) { return static_cast<int>(std::floor(value)); }
 int Ceil(double value) { return static_cast<int>(std::ceil(value)); }
 int64_t RoundNs(double value) { return static_cast<int64_t>(std::llround(value)); }
 size_t Index(int value) { return static_cast<size_t>(value); }
-
-// "600x400+80x90": position then size, as the header's messages spell a region.
-std::string RectText(const cv::Rect& rect) {
-  return std::to_string(rect.x) + "x" + std::to_string(rect.y) + "+" + std::to_string(rect.width) +
-         "x" + std::to_string(rect.height);
-}
-
-std::string SecondsText(int64_t t_ns) { return FormatFixed(static_cast<double>(t_ns) / 1e9, 4); }
 
 std::string MsText(int64_t t_ns) { return FormatFixed(static_cast<double>(t_ns) / 1e6, 1); }
 
@@ -608,17 +607,6 @@ std::vector<cv::Rect> ChooseReferencePatches(const cv::Mat& bgr, const FootGeome
   return chosen;
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  const double lower =
-      *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid));
-  return 0.5 * (lower + upper);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -653,6 +641,10 @@ Status FootTracker::Options::Validate() const {
                                 std::to_string(reference_roi_px.width) + " x " +
                                 std::to_string(reference_roi_px.height));
   }
+  if (!(compression_error_px >= 0) || !(compression_error_px <= 10)) {
+    return InvalidArgumentError("compression_error_px: expected 0 .. 10, got " +
+                                FormatFixed(compression_error_px, 3));
+  }
   if (!(exposure_s >= 0) || !(exposure_s <= 10)) {
     return InvalidArgumentError("exposure_s: expected 0 (unknown) .. 10, got " +
                                 FormatFixed(exposure_s, 6));
@@ -675,8 +667,8 @@ std::string FootTrack::Brief() const {
   } else {
     scale = FormatFixed(threshold_px, 2) + " px";
   }
-  return "liftoff (" + scale + ") at " + SecondsText(above_threshold.t_ns) + " s +- " +
-         MsText(above_threshold.uncertainty_ns) + " ms, onset " + SecondsText(onset.t_ns) +
+  return "liftoff (" + scale + ") at " + FormatSeconds(above_threshold.t_ns, 4) + " s +- " +
+         MsText(above_threshold.uncertainty_ns) + " ms, onset " + FormatSeconds(onset.t_ns, 4) +
          " s +- " + MsText(onset.uncertainty_ns) + " ms";
 }
 
@@ -873,8 +865,8 @@ void FootTracker::Impl::MeasureShake(const cv::Mat& bgr) {
     }
   }
   if (ys.empty()) return;  // keep the last shake
-  shake_x = Median(xs);
-  shake_y = Median(ys);
+  shake_x = MedianOf(xs);
+  shake_y = MedianOf(ys);
 }
 
 // The foot's vertical shift in the picture, searched first around where the last two
@@ -925,6 +917,8 @@ FootTracker::FootTracker(FootTracker&&) noexcept = default;
 FootTracker& FootTracker::operator=(FootTracker&&) noexcept = default;
 FootTracker::~FootTracker() = default;
 
+const std::vector<HeightSample>& FootTracker::samples() const { return impl_->samples; }
+
 void FootTracker::SetRestWindow(int64_t rest_from_ns, int64_t rest_to_ns) {
   impl_->rest_from_ns = rest_from_ns;
   impl_->rest_to_ns = rest_to_ns;
@@ -960,8 +954,9 @@ Status FootTracker::Process(const Frame& frame) {
     }
     if (frame.t_ns <= s.last_t_ns) {
       return InvalidArgumentError("frame " + std::to_string(frame.index) + " at " +
-                                  SecondsText(frame.t_ns) + " s is not after the previous one at " +
-                                  SecondsText(s.last_t_ns) + " s (frames must come in order)");
+                                  FormatSeconds(frame.t_ns, 4) +
+                                  " s is not after the previous one at " +
+                                  FormatSeconds(s.last_t_ns, 4) + " s (frames must come in order)");
     }
   }
   try {
@@ -1023,7 +1018,19 @@ Hinge FitHinge(const std::vector<double>& t_s, const std::vector<double>& y, dou
 
 }  // namespace
 
-Result<FootTrack> FootTracker::Finish() const {
+Result<FootTrack> FootTracker::Finish() const& {
+  Result<FootTrack> track = FinishWithoutSamples();
+  if (track.ok()) track->samples = impl_->samples;
+  return track;
+}
+
+Result<FootTrack> FootTracker::Finish() && {
+  Result<FootTrack> track = FinishWithoutSamples();
+  if (track.ok()) track->samples = std::move(impl_->samples);
+  return track;
+}
+
+Result<FootTrack> FootTracker::FinishWithoutSamples() const {
   const Impl& s = *impl_;
   if (!s.options_status.ok()) return s.options_status;
   if (s.samples.empty()) return InvalidArgumentError("no frame was given to the foot tracker");
@@ -1031,7 +1038,6 @@ Result<FootTrack> FootTracker::Finish() const {
   const std::vector<HeightSample>& samples = s.samples;
 
   FootTrack track;
-  track.samples = samples;
   track.foot_roi_px = o.foot_roi_px;
   for (const ReferencePatch& patch : s.patches) {
     track.reference_patches_px.push_back(patch.rect);
@@ -1045,13 +1051,22 @@ Result<FootTrack> FootTracker::Finish() const {
   track.template_last_row = s.foot_template.last();
   track.located_by_tape = s.foot.by_tape;
   track.warnings = s.warnings;
+  // a "foot" nearly as wide as its region is most likely the region's own edges
+  std::string region_warning;
+  if (s.foot.width > kWideFootFraction * o.foot_roi_px.width) {
+    region_warning = "the located foot is " + FormatFixed(s.foot.width, 0) + " px wide, " +
+                     FormatFixed(100 * s.foot.width / o.foot_roi_px.width, 0) +
+                     " % of the foot region's width: the region is probably far too large "
+                     "(give one around the foot only)";
+    track.warnings.push_back(region_warning);
+  }
 
   // frame interval and the mid-exposure offset
   std::vector<double> steps;
   for (size_t i = 1; i < samples.size(); ++i) {
     steps.push_back(static_cast<double>(samples[i].t_ns - samples[i - 1].t_ns));
   }
-  const double interval_ns = steps.empty() ? 1e9 / 30 : Median(steps);
+  const double interval_ns = steps.empty() ? 1e9 / 30 : MedianOf(std::move(steps));
   double offset_ns = 0, offset_uncertainty_ns = 0;
   if (o.exposure_s > 0) {
     offset_ns = 0.5 * o.exposure_s * 1e9;
@@ -1082,8 +1097,8 @@ Result<FootTrack> FootTracker::Finish() const {
       if (samples[i].t_ns < s.rest_to_ns && good(i)) rest.push_back(i);
     }
     if (rest.empty()) {
-      return InvalidArgumentError("the rest window " + SecondsText(s.rest_from_ns) + " .. " +
-                                  SecondsText(s.rest_to_ns) +
+      return InvalidArgumentError("the rest window " + FormatSeconds(s.rest_from_ns, 4) + " .. " +
+                                  FormatSeconds(s.rest_to_ns, 4) +
                                   " s holds no frame with a clear view of the foot");
     }
   } else {
@@ -1152,7 +1167,8 @@ Result<FootTrack> FootTracker::Finish() const {
   if (!crossing) {
     return NotFoundError("the foot never lifts: its largest rise is " +
                          FormatFixed(track.max_rise_px, 2) + " px above rest, below the " +
-                         threshold_text + " threshold");
+                         threshold_text + " threshold" +
+                         (region_warning.empty() ? std::string() : "; " + region_warning));
   }
   const size_t k = *crossing;
   const auto t_of = [&](size_t i) {  // mid-exposure, ns
@@ -1294,7 +1310,14 @@ Result<FootTrack> FootTracker::Finish() const {
           FormatFixed(wobble_px, 2) + " px): the threshold instant is interpolated locally");
     }
   }
-  // systematic terms: the curve's misfit (a codec's lag is not noise) and the scale's
+  // the mean lag a lossy codec leaves in slow sub-pixel motion: a sawtooth whose rms is the
+  // misfit, so its mean is sqrt(3) times that, at most compression_error_px; it moves the
+  // whole rise late and is independent of the fit's spread, so it adds in quadrature
+  if (slope > 0) {
+    const double codec_lag_px = std::min(o.compression_error_px, std::sqrt(3.0) * wobble_px);
+    spread_ns = std::hypot(spread_ns, codec_lag_px / slope);
+  }
+  // systematic terms: the curve's misfit (not noise: it does not average out) and the scale's
   if (slope > 0) {
     spread_ns += wobble_px / slope;
     if (track.px_per_mm_estimated) spread_ns += kEstimatedScaleFraction * threshold / slope;

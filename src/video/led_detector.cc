@@ -12,9 +12,13 @@
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "video_util.h"
 
 namespace liftoff::video {
 namespace {
+
+using internal::MedianOf;
+using internal::RectText;
 
 // Frames before a step that must be flat.
 constexpr int kBeforeFrames = 4;
@@ -73,22 +77,6 @@ constexpr double kLitFraction = 0.15;
 constexpr size_t kIntervalWindow = 31;
 // Recorded steps per region at most (a region that keeps stepping is no sync LED).
 constexpr size_t kMaxEventsPerRegion = 4096;
-
-std::string RectText(const cv::Rect& rect) {
-  return std::to_string(rect.x) + "x" + std::to_string(rect.y) + "+" + std::to_string(rect.width) +
-         "x" + std::to_string(rect.height);
-}
-
-template <typename T>
-T MedianOf(T* values, int count) {
-  std::nth_element(values, values + count / 2, values + count);
-  T middle = values[count / 2];
-  if (count % 2 == 0) {
-    const T below = *std::max_element(values, values + count / 2);
-    middle = static_cast<T>((middle + below) / 2);
-  }
-  return middle;
-}
 
 // Every how many of `count` values a quantile looks at (about kQuantileSamples of them).
 size_t SampleStride(size_t count) { return std::max<size_t>(1, count / kQuantileSamples); }

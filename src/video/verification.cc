@@ -15,6 +15,7 @@
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "video_util.h"
 
 namespace liftoff::video {
 namespace {
@@ -429,8 +430,12 @@ Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
   if (!options.video_path.empty()) {
     LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options.video_path));
     const double interval_s = SecondsFromNs(analysis.timing.median_interval_ns);
-    const double fps = interval_s > 0 ? 1.0 / interval_s : 30.0;
-    const bool opened = writer.open(options.video_path.string(), cv::CAP_ANY,
+    const double fps =
+        analysis.timing.fps > 0 ? analysis.timing.fps : (interval_s > 0 ? 1.0 / interval_s : 30.0);
+    // OpenCV's own Motion JPEG writer (no GStreamer or image-sequence backend to try and
+    // complain about on stderr), its log quiet while it opens
+    const internal::QuietOpenCvLog quiet;
+    const bool opened = writer.open(options.video_path.string(), cv::CAP_OPENCV_MJPEG,
                                     cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
                                     cv::Size(analysis.width_px, analysis.height_px));
     if (!opened) {

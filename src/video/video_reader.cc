@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -10,18 +11,19 @@
 #include <deque>
 #include <fstream>
 #include <mutex>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
 extern "C" {
 #include <libavutil/log.h>
 }
-#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "liftoff/core/file.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "video_util.h"
 
 namespace liftoff::video {
 namespace {
@@ -80,28 +82,15 @@ void InstallDecoderLogFilter() {
 }
 
 // While alive, FFmpeg's messages on this thread go to `log`, and OpenCV's own log (which
-// reports failed opens as errors) is silenced; the first reader in saves OpenCV's level,
-// the last one out puts it back.
-std::mutex g_cv_log_mutex;
-int g_cv_log_silencers = 0;
-cv::utils::logging::LogLevel g_cv_log_level = cv::utils::logging::LOG_LEVEL_WARNING;
-
+// reports failed opens as errors) is silenced.
 class CatchDecoderLog {
  public:
   explicit CatchDecoderLog(DecoderLog& log) : previous_(t_decoder_log) {
     InstallDecoderLogFilter();
     t_decoder_log = &log;
     g_readers_inside.fetch_add(1, std::memory_order_relaxed);
-    std::lock_guard lock(g_cv_log_mutex);
-    if (g_cv_log_silencers++ == 0) {
-      g_cv_log_level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
-    }
   }
   ~CatchDecoderLog() {
-    {
-      std::lock_guard lock(g_cv_log_mutex);
-      if (--g_cv_log_silencers == 0) cv::utils::logging::setLogLevel(g_cv_log_level);
-    }
     g_readers_inside.fetch_sub(1, std::memory_order_relaxed);
     t_decoder_log = previous_;
   }
@@ -109,11 +98,37 @@ class CatchDecoderLog {
   CatchDecoderLog& operator=(const CatchDecoderLog&) = delete;
 
  private:
+  internal::QuietOpenCvLog quiet_;
   DecoderLog* previous_;
 };
 
 // Whether the file starts like a container liftoff expects a camera video in: an MP4 /
 // QuickTime box, Matroska's EBML magic or a RIFF AVI header.
+// the four characters of a FourCC code; empty when unknown or not printable
+std::string FourccText(double code) {
+  if (!std::isfinite(code) || code <= 0 || code > 4294967295.0) return {};
+  const auto value = static_cast<uint32_t>(code);
+  std::string text;
+  for (int i = 0; i < 4; ++i) {
+    const auto c = static_cast<char>((value >> (8 * i)) & 0xFFu);
+    if (c == '\0') break;
+    if (c < ' ' || c > '~') return {};
+    text.push_back(c);
+  }
+  return text;
+}
+
+// codecs that keep every pixel: FFV1, HuffYUV, UtVideo, PNG, raw pictures (unknown: lossy)
+bool IsLosslessCodec(std::string fourcc) {
+  while (!fourcc.empty() && fourcc.back() == ' ') fourcc.pop_back();
+  for (char& c : fourcc) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  for (std::string_view lossless : {"FFV1", "HFYU", "FFVH", "ULRG", "ULRA", "ULY0", "ULY2", "ULY4",
+                                    "ULH0", "ULH2", "PNG", "MPNG", "RAW", "I420"}) {
+    if (fourcc == lossless) return true;
+  }
+  return false;
+}
+
 bool LooksLikeVideoContainer(const fs::path& path) {
   std::ifstream file(path, std::ios::binary);
   std::array<char, 12> head{};
@@ -128,14 +143,6 @@ bool LooksLikeVideoContainer(const fs::path& path) {
   }
   if (has(0, "\x1A\x45\xDF\xA3")) return true;
   return has(0, "RIFF") && (has(8, "AVI ") || has(8, "AVIX"));
-}
-
-// Median of a few intervals (copied: the caller's order is kept).
-int64_t MedianOf(std::vector<int64_t> values) {
-  if (values.empty()) return 0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 // The median of every interval of a clip in fixed memory: intervals are counted in bins
@@ -203,9 +210,10 @@ Status VideoReader::Options::Validate() const {
 
 std::string FrameTimingReport::Brief() const {
   std::string text = Plural(frames, "frame");
+  if (fps > 0) text += " at " + FormatFixed(fps, 2) + " fps";
   if (median_interval_ns > 0) {
-    text += ", " + FormatFixed(static_cast<double>(median_interval_ns) * 1e-6, 3) + " ms median (" +
-            FormatFixed(1e9 / static_cast<double>(median_interval_ns), 1) + " fps)";
+    text += ", " + FormatFixed(static_cast<double>(median_interval_ns) * 1e-6, 3) +
+            " ms median interval";
   }
   text += ", " + std::to_string(dropped_frames) + " dropped, " + std::to_string(repaired_frames) +
           " repaired, " + std::to_string(irregular_frames) + " irregular";
@@ -246,7 +254,7 @@ struct VideoReader::Impl {
     for (const IntervalEntry& entry : window) {
       if (!entry.repaired) read.push_back(entry.interval_ns);
     }
-    return MedianOf(std::move(read));
+    return internal::MedianOf(std::move(read));
   }
 
   void Judge(IntervalEntry& entry, int64_t median_ns) {
@@ -316,6 +324,11 @@ struct VideoReader::Impl {
       if (!entry.judged) Judge(entry, median_ns);
     }
     report.median_interval_ns = histogram.Median();
+    const int64_t span_ns = report.last_ns - report.first_ns;
+    report.fps = report.frames > 1 && span_ns > 0
+                     ? static_cast<double>(report.frames - 1 + report.dropped_frames) /
+                           SecondsFromNs(span_ns)
+                     : 0.0;
     report.decoder_errors = decoder_log.errors;
     report.first_decoder_error = decoder_log.first_error;
   }
@@ -384,6 +397,8 @@ Result<VideoReader> VideoReader::Open(const fs::path& path, const Options& optio
       return damaged("no decoder could open it" + impl->FfmpegSays());
     }
     impl->report.container_fps = impl->capture.get(cv::CAP_PROP_FPS);
+    impl->report.codec_fourcc = FourccText(impl->capture.get(cv::CAP_PROP_FOURCC));
+    impl->report.lossless_codec = IsLosslessCodec(impl->report.codec_fourcc);
     const double listed = impl->capture.get(cv::CAP_PROP_FRAME_COUNT);
     impl->report.container_frames =
         std::isfinite(listed) && listed > 0 ? static_cast<int64_t>(std::llround(listed)) : 0;

@@ -257,6 +257,60 @@ TEST(VideoOnCiSet, LiftoffRotationWithin0p01RadIn95PercentAnd0p02InAll) {
   EXPECT_GE(within_0p01, static_cast<int>(std::ceil(0.95 * count)));
 }
 
+// The frame rate of a file with timestamps rounded to 1 ms (FFV1 in MKV at 60 fps: 17, 17,
+// 16 ms) is its true rate, not 1 / the median interval (58.8 fps); the codec is known.
+TEST(VideoOnCiSet, MillisecondTimestampsGiveTheTrueFrameRate) {
+  LIFTOFF_REQUIRE_CI_SET(files);
+  LIFTOFF_REQUIRE_CI_RUN(run);
+  int checked = 0;
+  for (const nlohmann::json& entry : files.index["trials"]) {
+    const std::string id = entry["id"];
+    if (id != "ci-01-baseline-ffv1" && id != "ci-02-h264-bframes-30fps") continue;
+    const double fps = entry["spec"]["camera"]["fps"].get<double>();
+    for (const sync::TrialOutcome& outcome : run.analysis.outcomes) {
+      if (outcome.trial.id != id) continue;
+      ASSERT_TRUE(outcome.video.has_value()) << id;
+      EXPECT_NEAR(outcome.video->timing.fps, fps, 0.005 * fps) << id;
+      EXPECT_EQ(outcome.video->timing.lossless_codec, id == "ci-01-baseline-ffv1")
+          << id << ": " << outcome.video->timing.codec_fourcc;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 2);
+}
+
+// Each instant's interval (value +- uncertainty) must hold the truth: the LED switch-on in
+// every clip, and the 1 mm liftoff (whatever the codec does to slow sub-pixel motion).
+TEST(VideoOnCiSet, EveryUncertaintyHoldsTheTruth) {
+  LIFTOFF_REQUIRE_CI_SET(files);
+  LIFTOFF_REQUIRE_CI_RUN(run);
+  std::vector<double> led_ms, liftoff_ms;
+  for (const sync::TrialOutcome& outcome : run.analysis.outcomes) {
+    SCOPED_TRACE(outcome.trial.id);
+    const synth::GroundTruth* truth = TruthOf(files, outcome.trial.id);
+    ASSERT_NE(truth, nullptr);
+    ASSERT_TRUE(outcome.video.has_value()) << outcome.status.ToString();
+    const LedPulse& led = outcome.video->led_on();
+    const auto led_error_ns = std::abs(led.on_ns - *truth->led_on_video_ns);
+    EXPECT_LE(led_error_ns, led.on_uncertainty_ns)
+        << "LED error " << 1e-6 * static_cast<double>(led_error_ns) << " ms";
+    const TimedEvent* liftoff = outcome.video->liftoff();
+    ASSERT_NE(liftoff, nullptr);
+    const auto liftoff_error_ns = std::abs(liftoff->t_ns - *truth->liftoff_1mm_video_ns);
+    EXPECT_LE(liftoff_error_ns, liftoff->uncertainty_ns)
+        << "liftoff error " << 1e-6 * static_cast<double>(liftoff_error_ns) << " ms";
+    led_ms.push_back(1e-6 * static_cast<double>(led.on_uncertainty_ns));
+    liftoff_ms.push_back(1e-6 * static_cast<double>(liftoff->uncertainty_ns));
+  }
+  ASSERT_EQ(liftoff_ms.size(), 24u);
+  std::sort(led_ms.begin(), led_ms.end());
+  std::sort(liftoff_ms.begin(), liftoff_ms.end());
+  std::printf(
+      "half-widths: LED median %.1f ms, worst %.1f ms; liftoff median %.1f ms, worst %.1f ms\n",
+      led_ms[led_ms.size() / 2], led_ms.back(), liftoff_ms[liftoff_ms.size() / 2],
+      liftoff_ms.back());
+}
+
 // The analysis options an invalid input is tried with: its truth's regions and scale, or
 // (for files that are no clip) the first trial's.
 ClipAnalysisOptions InvalidInputOptions(const CiSetFiles& files, const nlohmann::json& entry) {
@@ -338,6 +392,9 @@ TEST(VideoOnCiSet, TableCommandOnTheManifestMatchesTruth) {
       EXPECT_NEAR(trial["liftoff_rad"].get<double>(), *truth->liftoff_1mm_rad, 0.02) << id;
       EXPECT_LE(trial["lower_rad"].get<double>(), trial["liftoff_rad"].get<double>()) << id;
       EXPECT_GE(trial["upper_rad"].get<double>(), trial["liftoff_rad"].get<double>()) << id;
+      // the interval holds the truth, not only the value
+      EXPECT_LE(trial["lower_rad"].get<double>(), *truth->liftoff_1mm_rad) << id;
+      EXPECT_GE(trial["upper_rad"].get<double>(), *truth->liftoff_1mm_rad) << id;
       ++checked;
     }
   }

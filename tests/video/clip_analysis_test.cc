@@ -314,6 +314,16 @@ TEST(AnalyzeClip, ErrorsSayWhatAndWhere) {
   outside.led.roi_px = cv::Rect(630, 10, 20, 20);
   auto led_outside = AnalyzeClip(clips.base.video_path, outside);
   EXPECT_EQ(led_outside.status().code(), StatusCode::kInvalidArgument);
+  // an exposure longer than the frame interval (16.7 ms at 60 fps), for the LED or the foot
+  for (const bool led : {true, false}) {
+    ClipAnalysisOptions long_exposure = OptionsFor(clips.base);
+    (led ? long_exposure.led.exposure_s : long_exposure.foot.exposure_s) = 0.018;
+    auto analysis = AnalyzeClip(clips.base.video_path, long_exposure);
+    EXPECT_EQ(analysis.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_THAT(analysis.status().message(), HasSubstr(led ? "led.exposure_s" : "foot.exposure_s"));
+    EXPECT_THAT(analysis.status().message(), HasSubstr("--exposure-ms"));
+    EXPECT_THAT(analysis.status().message(), HasSubstr("clip-base.mp4"));
+  }
   // bad options before any decoding
   ClipAnalysisOptions bad = OptionsFor(clips.base);
   bad.queue_frames = -1;
@@ -478,6 +488,10 @@ TEST(CliVideo, EachErrorHasItsExitCode) {
       {"video " + clip + " --liftoff knee", 3, "--liftoff: expected threshold or onset"},
       {"video " + clip + " --progress loud", 3, "--progress"},
       {"video " + clip + " --px-per-mm -1", 3, "--px-per-mm"},
+      {"video " + clip + " --foot-roi " + RectFlag(clips.base.truth.foot_roi_px) +
+           " --threshold-px 0",
+       3, "--threshold-px"},
+      {"video " + clip + " --exposure-ms 1000", 3, "--exposure-ms"},
       {"video " + clip + " --threshold-mm 1 --threshold-px 2", 2, "excludes"},
   };
   for (const Case& c : cases) {

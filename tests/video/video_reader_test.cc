@@ -345,11 +345,13 @@ TEST(VideoReader, OptionsOutOfRangeAreNamed) {
 TEST(FrameTimingReport, BriefSaysFramesRateAndCounts) {
   FrameTimingReport report;
   report.frames = 1432;
+  report.fps = 60.0;
   report.median_interval_ns = 16'666'667;
   report.dropped_frames = 3;
   report.repaired_frames = 2;
   EXPECT_EQ(report.Brief(),
-            "1432 frames, 16.667 ms median (60.0 fps), 3 dropped, 2 repaired, 0 irregular");
+            "1432 frames at 60.00 fps, 16.667 ms median interval, 3 dropped, 2 repaired, 0 "
+            "irregular");
 }
 
 }  // namespace

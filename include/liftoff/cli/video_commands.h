@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -29,10 +30,12 @@ struct VideoCommand {
   std::string foot;
   /// Image scale at the foot, px per mm; 0: estimated from the foot's width.
   double px_per_mm = 0.0;
-  /// Liftoff threshold above rest: mm (with the scale), or px when threshold_px > 0.
+  /// Liftoff threshold above rest: mm (with the scale), or px when threshold_px is given
+  /// (> 0; then threshold_mm is ignored).
   double threshold_mm = 1.0;
-  double threshold_px = 0.0;
-  /// Camera exposure per frame, ms; 0: unknown (taken as the frame interval).
+  std::optional<double> threshold_px;
+  /// Camera exposure per frame, ms (> 0, at most 1.05 frame intervals); 0: unknown (the
+  /// LED allows any exposure up to the frame interval, the foot takes half of it).
   double exposure_ms = 0.0;
   /// Rest window "FROM,TO", s relative to the LED switch-on.
   std::string rest_window = "-0.5,0";

@@ -122,8 +122,12 @@ struct ClipAnalysis {
 
 /// Analyses the clip at `path`. Errors: options' kInvalidArgument; the reader's (kNotFound
 /// no such file, kParse not a video / truncated or damaged); kInvalidArgument when a
-/// region lies outside the frame; kNotFound when the LED never switches on or the foot
-/// never lifts. Messages name the file. `progress` may be empty.
+/// region lies outside the frame, or when led.exposure_s or foot.exposure_s exceeds 1.05
+/// times the clip's median frame interval (checked once the clip is read; the message
+/// names the field and --exposure-ms); kNotFound when the LED never switches on or the
+/// foot never lifts. Messages name the file. A lossless codec
+/// (FrameTimingReport::lossless_codec) sets foot.compression_error_px to 0. `progress` may
+/// be empty.
 Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
                                  const ClipAnalysisOptions& options,
                                  const ClipProgress& progress = {});

@@ -112,8 +112,10 @@ struct FootTrack {
   /// allows within two standard deviations, plus the time the hinge takes to rise by three
   /// times its misfit near the crossing (a smooth knee is poorly defined, and compression
   /// holds a slowly starting foot still). The threshold instant's spans the crossings of
-  /// those hinges and the rest level's error, plus the misfit over the slope, 3 % of the
-  /// threshold when the scale is estimated, and the exposure's timing when unknown.
+  /// those hinges and the rest level's error, with the codec's mean sub-pixel lag over the
+  /// slope in quadrature (Options::compression_error_px), plus the misfit over the slope,
+  /// 3 % of the threshold when the scale is estimated, and the exposure's timing when
+  /// unknown.
   TimedEvent onset;
   TimedEvent above_threshold;
   std::vector<std::string> warnings;
@@ -153,6 +155,14 @@ class FootTracker {
     /// shows the foot's mean position over its exposure, so samples are dated at
     /// mid-exposure when the instants are computed.
     double exposure_s = 0.0;
+    /// The largest mean offset a lossy codec leaves in the foot's sub-pixel position while
+    /// it moves slowly, px, >= 0: H.264 lets a slowly rising foot lag by 0 .. ~0.4 px,
+    /// then catch up, so the curve runs late by up to ~0.2 px on average, which no fit can
+    /// see. The lag is a sawtooth about the hinge whose rms is the hinge's misfit m, so the
+    /// offset used is min(sqrt(3) m, this); over the slope at the crossing, it is added in
+    /// quadrature to the threshold instant's spread. AnalyzeClip sets 0 for a lossless
+    /// codec (FrameTimingReport::lossless_codec).
+    double compression_error_px = 0.2;
     /// A crossing counts only when this many consecutive frames are above the threshold
     /// (a noise spike is not a liftoff), >= 1.
     int confirm_frames = 3;
@@ -181,10 +191,18 @@ class FootTracker {
   /// The result. kNotFound "the foot never lifts" (with its largest rise in the message)
   /// when it never stays above the threshold from the start of the rest window on;
   /// kInvalidArgument when no frame was fed, the options do not validate, or the rest
-  /// window holds no frame with a clear view of the foot. May be called more than once.
-  Result<FootTrack> Finish() const;
+  /// window holds no frame with a clear view of the foot. May be called more than once;
+  /// on an expiring tracker (std::move(tracker).Finish()) the samples move into the result
+  /// instead of being copied, and the tracker is left without them.
+  Result<FootTrack> Finish() const&;
+  Result<FootTrack> Finish() &&;
+  /// The frames fed so far (the rest window rule needs their times before Finish).
+  const std::vector<HeightSample>& samples() const;
 
  private:
+  // everything but the samples
+  Result<FootTrack> FinishWithoutSamples() const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

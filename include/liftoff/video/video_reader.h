@@ -44,10 +44,20 @@ struct FrameTimingReport {
   /// The usual interval: the median of all read (not repaired) intervals, ns; exact for a
   /// constant rate, else within 0.3 % (a fixed histogram keeps memory flat).
   int64_t median_interval_ns = 0;
+  /// Frame rate, Hz: (frames - 1 + dropped_frames) / (last_ns - first_ns), the frames
+  /// over the span of their times. Unlike 1 / median_interval_ns it is not biased by
+  /// timestamps rounded to 1 ms (MKV at 60 fps: 17, 17, 16 ms, median 17 ms = 58.8 fps).
+  /// 0 with fewer than two frames.
+  double fps = 0.0;
   double container_fps = 0.0;    ///< what the container claims (not used), Hz
   int64_t container_frames = 0;  ///< what the container claims (not used)
-  int64_t dropped_frames = 0;    ///< sum of missing_frames
-  int64_t repaired_frames = 0;   ///< frames with t_repaired
+  /// The codec's FourCC as the backend reports it ("FFV1", "avc1", "h264", "MJPG"; empty
+  /// when unknown), and whether it is a lossless codec (FFV1, HuffYUV, UtVideo, PNG, raw).
+  /// Lossy codecs update slow sub-pixel motion in steps (see FootTracker::Options).
+  std::string codec_fourcc;
+  bool lossless_codec = false;
+  int64_t dropped_frames = 0;   ///< sum of missing_frames
+  int64_t repaired_frames = 0;  ///< frames with t_repaired
   /// Every irregular, dropped or repaired frame, in order (at most max_listed; the counts
   /// above are complete).
   std::vector<TimingIrregularity> irregularities;
@@ -56,7 +66,7 @@ struct FrameTimingReport {
   /// printed): damage the decoder concealed, or that ended the stream. The first one's text.
   int64_t decoder_errors = 0;
   std::string first_decoder_error;
-  /// "1432 frames, 16.667 ms median (60.0 fps), 3 dropped, 2 repaired, 0 irregular"
+  /// "1432 frames at 60.00 fps, 16.667 ms median interval, 3 dropped, 2 repaired, 0 irregular"
   /// (", 2 decoder errors" appended when there were any).
   std::string Brief() const;
 };

@@ -1,0 +1,84 @@
+// Small helpers the video module's sources share (private: not installed, not for other
+// modules).
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
+
+#include "liftoff/core/text.h"
+
+namespace liftoff::video::internal {
+
+// "600x400+80x90": position then size, as the headers' messages spell a region.
+inline std::string RectText(const cv::Rect& rect) {
+  return std::to_string(rect.x) + "x" + std::to_string(rect.y) + "+" + std::to_string(rect.width) +
+         "x" + std::to_string(rect.height);
+}
+
+// "4.2 ms": a duration in ns as milliseconds, one decimal.
+inline std::string Milliseconds(int64_t ns) {
+  return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
+}
+
+// The median of values[0, count) (reordered; the mean of the middle two for an even
+// count); 0 for none.
+template <typename T>
+T MedianOf(T* values, std::ptrdiff_t count) {
+  if (count <= 0) return T{};
+  const std::ptrdiff_t mid = count / 2;
+  std::nth_element(values, values + mid, values + count);
+  T middle = values[mid];
+  if (count % 2 == 0) {
+    const T below = *std::max_element(values, values + mid);
+    middle = static_cast<T>((middle + below) / 2);
+  }
+  return middle;
+}
+
+// The median of a copy of `values` (the caller's order is kept).
+template <typename T>
+T MedianOf(std::vector<T> values) {
+  return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
+}
+
+// While alive, OpenCV's own log is silent (it reports failed opens and missing backends as
+// errors on stderr; liftoff reports them itself). Nests across threads: the first one in
+// saves OpenCV's level, the last one out puts it back.
+class QuietOpenCvLog {
+ public:
+  QuietOpenCvLog() {
+    const std::lock_guard<std::mutex> lock(Mutex());
+    if (Count()++ == 0) {
+      SavedLevel() = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    }
+  }
+  ~QuietOpenCvLog() {
+    const std::lock_guard<std::mutex> lock(Mutex());
+    if (--Count() == 0) cv::utils::logging::setLogLevel(SavedLevel());
+  }
+  QuietOpenCvLog(const QuietOpenCvLog&) = delete;
+  QuietOpenCvLog& operator=(const QuietOpenCvLog&) = delete;
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  static int& Count() {
+    static int count = 0;
+    return count;
+  }
+  static cv::utils::logging::LogLevel& SavedLevel() {
+    static cv::utils::logging::LogLevel level = cv::utils::logging::LOG_LEVEL_WARNING;
+    return level;
+  }
+};
+
+}  // namespace liftoff::video::internal
