@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -37,6 +38,36 @@ void AddLookupFlags(CLI::App* app, LookupChoice& lookup) {
   app->add_option("--max-bad-lines", lookup.max_bad_lines,
                   "Malformed log lines to skip (reported) before a log is rejected")
       ->capture_default_str();
+}
+
+// the clip analysis' regions, foot, scale, threshold and exposure (`video` and `sync`);
+// the options are returned so a mode flag can require or exclude them
+std::vector<CLI::Option*> AddClipFlags(CLI::App* app, ClipChoice& clip) {
+  std::vector<CLI::Option*> options;
+  options.push_back(app->add_option(
+      "--led-roi", clip.led_roi, "LED region x,y,w,h in pixels (default: located automatically)"));
+  options.push_back(app->add_option("--foot-roi", clip.foot_roi,
+                                    "Foot region x,y,w,h in pixels: the foot at rest and room "
+                                    "above it (without it: the LED only)"));
+  options.push_back(
+      app->add_option("--foot", clip.foot, "Track this foot's tape colour too: A, B, C or D"));
+  options.push_back(
+      app->add_option("--px-per-mm", clip.px_per_mm,
+                      "Image scale at the foot, px per mm (default: from the foot's width)"));
+  CLI::Option* threshold_mm =
+      app->add_option("--threshold-mm", clip.threshold_mm, "Liftoff threshold above rest, mm")
+          ->capture_default_str();
+  options.push_back(threshold_mm);
+  options.push_back(
+      app->add_option("--threshold-px", clip.threshold_px,
+                      "Liftoff threshold above rest, px (> 0; instead of --threshold-mm)")
+          ->excludes(threshold_mm));
+  options.push_back(app->add_option(
+      "--exposure-ms", clip.exposure_ms,
+      "Camera exposure per frame, ms, at most the frame interval (default 0: unknown; the LED "
+      "then allows any exposure up to the frame interval, the foot takes half the frame "
+      "interval)"));
+  return options;
 }
 
 void AddTestFlags(CLI::App* app, TestChoice& test) {
@@ -150,12 +181,34 @@ int main(int argc, char** argv) {
   import_app->add_flag("--force", import.force, "Overwrite an existing manifest");
 
   SyncCommand sync;
-  CLI::App* sync_app =
-      app.add_subcommand("sync", "Rotation at liftoff from one log and the two video instants");
+  CLI::App* sync_app = app.add_subcommand(
+      "sync",
+      "Rotation at liftoff from one log and the two video instants, given or found in the clip");
   sync_app->add_option("log", sync.log_path, "Controller log")->required();
-  sync_app->add_option("--led-on", sync.led_on_s, "Video time of the LED switch-on, s")->required();
-  sync_app->add_option("--liftoff", sync.liftoff_s, "Video time of the liftoff, s")->required();
-  sync_app->add_option("--uncertainty", sync.uncertainty_s, "Timing uncertainty of each instant, s")
+  CLI::Option* led_on =
+      sync_app->add_option("--led-on", sync.led_on_s, "Video time of the LED switch-on, s");
+  CLI::Option* liftoff =
+      sync_app->add_option("--liftoff", sync.liftoff_s, "Video time of the liftoff, s");
+  CLI::Option* uncertainty =
+      sync_app
+          ->add_option("--uncertainty", sync.uncertainty_s, "Timing uncertainty of each instant, s")
+          ->capture_default_str();
+  led_on->needs(liftoff);
+  liftoff->needs(led_on);
+  CLI::Option* sync_video =
+      sync_app
+          ->add_option("--video", sync.video_path,
+                       "Find the two instants in this clip (instead of --led-on and --liftoff)")
+          ->excludes(led_on)
+          ->excludes(liftoff)
+          ->excludes(uncertainty);
+  for (CLI::Option* option : AddClipFlags(sync_app, sync.clip)) option->needs(sync_video);
+  sync_app
+      ->add_option("--verify", sync.verify_path, "With --video: write a verification image (PNG)")
+      ->needs(sync_video);
+  sync_app
+      ->add_option("--progress", sync.progress,
+                   "With --video: progress on stderr: auto, live, lines or off")
       ->capture_default_str();
   sync_app->add_option("--log-format", sync.log_format, "auto, liftoff or laika-2018")
       ->capture_default_str();
@@ -267,32 +320,13 @@ int main(int argc, char** argv) {
   CLI::App* video_app = app.add_subcommand(
       "video", "Find the LED switch-on and the foot's liftoff in one clip, with proof");
   video_app->add_option("clip", video.video_path, "Video file")->required();
-  video_app->add_option("--led-roi", video.led_roi,
-                        "LED region x,y,w,h in pixels (default: located automatically)");
-  video_app->add_option("--foot-roi", video.foot_roi,
-                        "Foot region x,y,w,h in pixels: the foot at rest and room above it "
-                        "(without it: the LED only)");
-  video_app->add_option("--foot", video.foot, "Track this foot's tape colour too: A, B, C or D");
-  video_app->add_option("--px-per-mm", video.px_per_mm,
-                        "Image scale at the foot, px per mm (default: from the foot's width)");
-  CLI::Option* threshold_mm =
-      video_app
-          ->add_option("--threshold-mm", video.threshold_mm, "Liftoff threshold above rest, mm")
-          ->capture_default_str();
-  video_app
-      ->add_option("--threshold-px", video.threshold_px,
-                   "Liftoff threshold above rest, px (> 0; instead of --threshold-mm)")
-      ->excludes(threshold_mm);
-  video_app->add_option("--exposure-ms", video.exposure_ms,
-                        "Camera exposure per frame, ms, at most the frame interval (default 0: "
-                        "unknown; the LED then allows any exposure up to the frame interval, "
-                        "the foot takes half the frame interval)");
+  AddClipFlags(video_app, video.clip);
   video_app
       ->add_option(
-          "--rest-window", video.rest_window,
+          "--rest-window", video.clip.rest_window,
           "Foot rest window FROM,TO in s from the LED switch-on (write --rest-window=-1,0)")
       ->capture_default_str();
-  video_app->add_option("--liftoff", video.liftoff, "Liftoff instant: threshold or onset")
+  video_app->add_option("--liftoff", video.clip.liftoff, "Liftoff instant: threshold or onset")
       ->capture_default_str();
   video_app->add_option("--verify", video.verify_path, "Write a verification image (PNG)");
   video_app->add_option("--annotate", video.annotate_path,

@@ -18,6 +18,8 @@
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
 #include "liftoff/sync/trial_analysis.h"
+#include "liftoff/video/clip_analysis.h"
+#include "liftoff/video/verification.h"
 
 namespace liftoff::cli {
 namespace {
@@ -47,6 +49,26 @@ Result<TrialManifest> LoadTrials(const std::filesystem::path& path, std::ostream
   if (!imported.ok()) return imported.status();
   for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
   return std::move(imported->manifest);
+}
+
+// the two instants from the command line: both, bounded so they convert to nanoseconds
+Result<EventTimes> TimesFromFlags(const SyncCommand& command) {
+  if (!command.led_on_s || !command.liftoff_s) {
+    return InvalidArgumentError("--led-on and --liftoff: give both video instants, or --video");
+  }
+  constexpr NumberRange kTimeRange{.min = 0.0, .max = kMaxTimeSeconds};
+  for (const auto& [flag, value_s] :
+       {std::pair{"--led-on", *command.led_on_s}, std::pair{"--liftoff", *command.liftoff_s},
+        std::pair{"--uncertainty", command.uncertainty_s}}) {
+    LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag(flag, value_s, kTimeRange));
+  }
+  EventTimes times;
+  times.led_on_ns = NsFromSeconds(*command.led_on_s);
+  times.liftoff_ns = NsFromSeconds(*command.liftoff_s);
+  times.led_on_uncertainty_ns = NsFromSeconds(command.uncertainty_s);
+  times.liftoff_uncertainty_ns = times.led_on_uncertainty_ns;
+  times.source = "command line";
+  return times;
 }
 
 }  // namespace
@@ -174,16 +196,44 @@ int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostr
 // liftoff sync
 
 int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
+  // flags: exactly one source of the video instants
   auto lookup = LookupOptionsFrom(command.lookup);
   if (!lookup.ok()) return ReportError(lookup.status(), err);
-  // video times and their uncertainty, bounded so they convert to nanoseconds
-  constexpr NumberRange kTimeRange{.min = 0.0, .max = kMaxTimeSeconds};
-  for (const auto& [flag, value_s] :
-       {std::pair{"--led-on", command.led_on_s}, std::pair{"--liftoff", command.liftoff_s},
-        std::pair{"--uncertainty", command.uncertainty_s}}) {
-    const Status checked = CheckSecondsFlag(flag, value_s, kTimeRange);
-    if (!checked.ok()) return ReportError(checked, err);
+  const bool from_video = !command.video_path.empty();
+  const bool from_flags = command.led_on_s || command.liftoff_s;
+  if (from_video && (from_flags || command.uncertainty_s != 0.0)) {
+    return ReportError(InvalidArgumentError("--video excludes --led-on, --liftoff and "
+                                            "--uncertainty: the clip's analysis gives the instants "
+                                            "and their uncertainties"),
+                       err);
   }
+  if (!from_video && !from_flags) {
+    return ReportError(InvalidArgumentError("no video instants: give --led-on S --liftoff S, or "
+                                            "--video CLIP --foot-roi x,y,w,h to find them"),
+                       err);
+  }
+  EventTimes times;
+  std::optional<video::ClipAnalysisOptions> clip_options;
+  std::optional<VideoProgress> progress;
+  if (from_video) {
+    if (command.clip.foot_roi.empty()) {
+      return ReportError(
+          InvalidArgumentError("--video needs --foot-roi x,y,w,h: the liftoff comes from the foot"),
+          err);
+    }
+    auto options = ClipOptionsFrom(command.clip);
+    if (!options.ok()) return ReportError(options.status(), err);
+    clip_options = std::move(options).value();
+    auto created = VideoProgress::Create(command.progress, err);
+    if (!created.ok()) return ReportError(created.status(), err);
+    progress = std::move(created).value();
+  } else {
+    auto flagged = TimesFromFlags(command);
+    if (!flagged.ok()) return ReportError(flagged.status(), err);
+    times = std::move(flagged).value();
+  }
+
+  // the log (before the video: a bad log fails fast)
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   LogReadOptions read_options;
@@ -192,12 +242,24 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   if (!log.ok()) return ReportError(log.status(), err);
   PrintLogWarnings(log->report, err);
 
-  EventTimes times;
-  times.led_on_ns = NsFromSeconds(command.led_on_s);
-  times.liftoff_ns = NsFromSeconds(command.liftoff_s);
-  times.led_on_uncertainty_ns = NsFromSeconds(command.uncertainty_s);
-  times.liftoff_uncertainty_ns = times.led_on_uncertainty_ns;
-  times.source = "command line";
+  // the instants from the clip, with proof when asked for
+  std::optional<video::ClipAnalysis> clip;
+  if (from_video) {
+    auto analysis = AnalyzeClipShowingProgress(command.video_path, *clip_options, *progress);
+    if (!analysis.ok()) return ReportError(analysis.status(), err);
+    clip = std::move(analysis).value();
+    for (const std::string& warning : clip->warnings) err << "warning: video: " << warning << '\n';
+    auto events = clip->Events();
+    if (!events.ok()) return ReportError(events.status(), err);
+    times = std::move(events).value();
+    if (!command.verify_path.empty()) {
+      video::VerificationOptions verify_options;
+      verify_options.image_path = command.verify_path;
+      auto written = video::WriteVerification(*clip, verify_options);
+      if (!written.ok()) return ReportError(written.status(), err);
+      err << "wrote " << written->Brief() << '\n';
+    }
+  }
   auto measured = sync::MeasureLiftoff(*log, times, *lookup);
   if (!measured.ok()) {
     return ReportError(measured.status().WithContext(command.log_path.filename().string()), err);
@@ -219,10 +281,18 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
         {"in_gap", at.in_gap},
         {"past_end", at.past_end},
         {"warnings", at.warnings},
+        {"times",
+         {{"source", times.source},
+          {"led_on_s", SecondsFromNs(times.led_on_ns)},
+          {"led_on_uncertainty_s", SecondsFromNs(times.led_on_uncertainty_ns)},
+          {"liftoff_s", SecondsFromNs(times.liftoff_ns)},
+          {"liftoff_uncertainty_s", SecondsFromNs(times.liftoff_uncertainty_ns)}}},
+        {"video", clip ? clip->ToJson() : nlohmann::json()},
     };
     out << document.dump(2) << '\n';
     return kExitOk;
   }
+  if (clip) out << "video: " << clip->Brief() << '\n';
   out << "calibration: " << calibration->Brief() << "; rule: " << sync::LookupRuleName(lookup->rule)
       << '\n'
       << "interval LED on -> liftoff: " << FormatSeconds(measured->interval_ns, 3) << " s +- "

@@ -51,52 +51,6 @@ Result<std::pair<double, double>> ParseRestWindow(const std::string& text) {
   }
 }
 
-// the command's flags as analysis options
-Result<video::ClipAnalysisOptions> ClipOptionsFrom(const VideoCommand& command) {
-  video::ClipAnalysisOptions options;
-  if (!command.led_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, video::ParseRect(command.led_roi, "--led-roi"));
-  }
-  if (!command.foot_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
-                             video::ParseRect(command.foot_roi, "--foot-roi"));
-  }
-  if (!command.foot.empty()) {
-    const std::optional<Foot> foot = ParseFoot(command.foot);
-    if (!foot) {
-      return InvalidArgumentError("--foot: expected A, B, C or D, got \"" + command.foot + "\"");
-    }
-    options.foot.tape_colour = *foot;
-  }
-  LIFTOFF_RETURN_IF_ERROR(
-      CheckNumberFlag("--px-per-mm", command.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
-  LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-mm", command.threshold_mm,
-                                          {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
-  if (command.threshold_px) {
-    LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-px", *command.threshold_px,
-                                            {.min = 0.0, .max = 1000.0, .min_exclusive = true},
-                                            "px"));
-  }
-  LIFTOFF_RETURN_IF_ERROR(
-      CheckNumberFlag("--exposure-ms", command.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
-  options.foot.px_per_mm = command.px_per_mm;
-  options.foot.threshold_mm = command.threshold_mm;
-  options.foot.threshold_px = command.threshold_px.value_or(0.0);
-  options.led.exposure_s = 1e-3 * command.exposure_ms;
-  options.foot.exposure_s = options.led.exposure_s;
-  LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(command.rest_window));
-  options.rest_from_led_s = rest.first;
-  options.rest_to_led_s = rest.second;
-  const std::optional<video::LiftoffInstant> instant = video::ParseLiftoffInstant(command.liftoff);
-  if (!instant) {
-    return InvalidArgumentError("--liftoff: expected threshold or onset, got \"" + command.liftoff +
-                                "\"");
-  }
-  options.liftoff = *instant;
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
-  return options;
-}
-
 std::string Milliseconds(int64_t ns) {
   return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
 }
@@ -146,6 +100,54 @@ std::string FileStem(const std::string& id) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------
+// a clip analysis' flags
+
+Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
+  video::ClipAnalysisOptions options;
+  if (!choice.led_roi.empty()) {
+    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, video::ParseRect(choice.led_roi, "--led-roi"));
+  }
+  if (!choice.foot_roi.empty()) {
+    LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
+                             video::ParseRect(choice.foot_roi, "--foot-roi"));
+  }
+  if (!choice.foot.empty()) {
+    const std::optional<Foot> foot = ParseFoot(choice.foot);
+    if (!foot) {
+      return InvalidArgumentError("--foot: expected A, B, C or D, got \"" + choice.foot + "\"");
+    }
+    options.foot.tape_colour = *foot;
+  }
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckNumberFlag("--px-per-mm", choice.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
+  LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-mm", choice.threshold_mm,
+                                          {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
+  if (choice.threshold_px) {
+    LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-px", *choice.threshold_px,
+                                            {.min = 0.0, .max = 1000.0, .min_exclusive = true},
+                                            "px"));
+  }
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckNumberFlag("--exposure-ms", choice.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
+  options.foot.px_per_mm = choice.px_per_mm;
+  options.foot.threshold_mm = choice.threshold_mm;
+  options.foot.threshold_px = choice.threshold_px.value_or(0.0);
+  options.led.exposure_s = 1e-3 * choice.exposure_ms;
+  options.foot.exposure_s = options.led.exposure_s;
+  LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(choice.rest_window));
+  options.rest_from_led_s = rest.first;
+  options.rest_to_led_s = rest.second;
+  const std::optional<video::LiftoffInstant> instant = video::ParseLiftoffInstant(choice.liftoff);
+  if (!instant) {
+    return InvalidArgumentError("--liftoff: expected threshold or onset, got \"" + choice.liftoff +
+                                "\"");
+  }
+  options.liftoff = *instant;
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
 
 // ---------------------------------------------------------------------------------------
 // progress
@@ -200,21 +202,26 @@ void VideoProgress::Done() {
   last_width_ = 0;
 }
 
+Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::path& path,
+                                                       const video::ClipAnalysisOptions& options,
+                                                       VideoProgress& progress) {
+  const std::string label = path.filename().string();
+  auto analysis = video::AnalyzeClip(path, options, [&](int64_t frames_done, int64_t t_ns) {
+    progress.Show(label, frames_done, t_ns);
+  });
+  progress.Done();
+  return analysis;
+}
+
 // ---------------------------------------------------------------------------------------
 // liftoff video
 
 int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) {
-  auto options = ClipOptionsFrom(command);
+  auto options = ClipOptionsFrom(command.clip);
   if (!options.ok()) return ReportError(options.status(), err);
   auto progress = VideoProgress::Create(command.progress, err);
   if (!progress.ok()) return ReportError(progress.status(), err);
-  const std::string label = command.video_path.filename().string();
-
-  // the pass
-  auto analysis = video::AnalyzeClip(
-      command.video_path, *options,
-      [&](int64_t frames_done, int64_t t_ns) { progress->Show(label, frames_done, t_ns); });
-  progress->Done();
+  auto analysis = AnalyzeClipShowingProgress(command.video_path, *options, *progress);
   if (!analysis.ok()) return ReportError(analysis.status(), err);
 
   // proof, when asked for (a second decode)

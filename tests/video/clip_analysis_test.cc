@@ -501,5 +501,61 @@ TEST(CliVideo, EachErrorHasItsExitCode) {
   }
 }
 
+TEST(CliSync, VideoModeFindsTheRotationAtLiftoffFromTheClip) {
+  LIFTOFF_REQUIRE_CLIPS(clips);
+  ScratchDir scratch;
+  const synth::GroundTruth& truth = clips.base.truth;
+  ASSERT_TRUE(truth.liftoff_1mm_rad.has_value());
+  const CommandRun run =
+      RunBinary("sync " + Quoted(clips.base.log_path) + " -c " +
+                    Quoted(SourceDir() / "calib" / "laika-2018.json") + " --video " +
+                    Quoted(clips.base.video_path) + " --led-roi " + RectFlag(truth.led_roi_px) +
+                    " --foot-roi " + RectFlag(truth.foot_roi_px) + " --foot A --px-per-mm " +
+                    std::to_string(truth.px_per_mm) + " --progress off --json",
+                scratch);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json document = nlohmann::json::parse(run.out);
+  EXPECT_NEAR(document["liftoff_rad"].get<double>(), *truth.liftoff_1mm_rad, 0.01);
+  // the instants are the clip's, within the analysis' tolerance of the truth
+  const double frame_s = SecondsFromNs(FrameIntervalNs(truth));
+  EXPECT_EQ(document["times"]["source"], "video");
+  EXPECT_NEAR(document["times"]["led_on_s"].get<double>(), SecondsFromNs(*truth.led_on_video_ns),
+              frame_s / 2);
+  EXPECT_NEAR(document["times"]["liftoff_s"].get<double>(),
+              SecondsFromNs(*truth.liftoff_1mm_video_ns), 3 * frame_s);
+  EXPECT_GT(document["times"]["liftoff_uncertainty_s"].get<double>(), 0.0);
+  EXPECT_EQ(document["video"]["events"]["liftoff_s"], document["times"]["liftoff_s"]);
+}
+
+TEST(CliSync, VideoModeAndHandInstantsExcludeEachOtherAndOneIsNeeded) {
+  LIFTOFF_REQUIRE_CLIPS(clips);
+  ScratchDir scratch;
+  const std::string log = Quoted(clips.base.log_path);
+  const std::string clip = Quoted(clips.base.video_path);
+  const std::string foot_roi = " --foot-roi " + RectFlag(clips.base.truth.foot_roi_px);
+  struct Case {
+    std::string arguments;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"sync " + log + " --video " + clip + foot_roi + " --led-on 0.6 --liftoff 2", 2, "excludes"},
+      {"sync " + log + " --video " + clip + foot_roi + " --uncertainty 0.01", 2, "excludes"},
+      {"sync " + log, 3, "--led-on S --liftoff S, or --video CLIP"},
+      {"sync " + log + " --led-on 0.6", 2, "requires"},
+      {"sync " + log + " --led-on 0.6 --liftoff 2" + foot_roi, 2, "requires"},
+      {"sync " + log + " --video " + clip, 3, "--video needs --foot-roi"},
+      // the video analysis' errors keep their exit codes
+      {"sync " + log + " --video " + Quoted(clips.not_a_video) + foot_roi, 5, "not a video"},
+      {"sync " + log + " --video " + clip + " --foot-roi 600,400,100,100", 3, "outside"},
+      {"sync " + log + " --video " + clip + foot_roi + " --progress loud", 3, "--progress"},
+  };
+  for (const Case& c : cases) {
+    const CommandRun run = RunBinary(c.arguments, scratch);
+    EXPECT_EQ(run.code, c.code) << c.arguments << "\n" << run.err;
+    EXPECT_THAT(run.err, HasSubstr(c.message)) << c.arguments;
+  }
+}
+
 }  // namespace
 }  // namespace liftoff::video

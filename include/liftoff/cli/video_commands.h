@@ -16,6 +16,7 @@
 #include "liftoff/cli/commands.h"
 #include "liftoff/core/status.h"
 #include "liftoff/sync/trial_analysis.h"
+#include "liftoff/video/clip_analysis.h"
 
 namespace liftoff::cli {
 
@@ -23,24 +24,7 @@ namespace liftoff::cli {
 /// liftoff; text, or the analysis as JSON (docs/video.md, "JSON output").
 struct VideoCommand {
   std::filesystem::path video_path;
-  /// Regions "x,y,w,h", px. LED: empty = locate automatically. Foot: empty = LED only.
-  std::string led_roi;
-  std::string foot_roi;
-  /// The foot whose tape colour to track (A, B, C, D); empty: edges only.
-  std::string foot;
-  /// Image scale at the foot, px per mm; 0: estimated from the foot's width.
-  double px_per_mm = 0.0;
-  /// Liftoff threshold above rest: mm (with the scale), or px when threshold_px is given
-  /// (> 0; then threshold_mm is ignored).
-  double threshold_mm = 1.0;
-  std::optional<double> threshold_px;
-  /// Camera exposure per frame, ms (> 0, at most 1.05 frame intervals); 0: unknown (the
-  /// LED allows any exposure up to the frame interval, the foot takes half of it).
-  double exposure_ms = 0.0;
-  /// Rest window "FROM,TO", s relative to the LED switch-on.
-  std::string rest_window = "-0.5,0";
-  /// Which foot instant is the liftoff: "threshold" or "onset".
-  std::string liftoff = "threshold";
+  ClipChoice clip;
   /// Verification image (PNG) and annotated video (MJPG AVI) to write; empty: none.
   std::filesystem::path verify_path;
   std::filesystem::path annotate_path;
@@ -50,6 +34,9 @@ struct VideoCommand {
   std::string progress = "auto";
 };
 int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err);
+
+/// The flags of a clip analysis as its options; kInvalidArgument naming the flag.
+Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice);
 
 /// A progress line on `err` for long video analyses: rewritten in place ("live"), one line
 /// every 5 s of wall time ("lines"), or nothing ("off"); "auto" is live when `err` is the
@@ -74,6 +61,12 @@ class VideoProgress {
   int64_t last_shown_ns_ = 0;
   size_t last_width_ = 0;
 };
+
+/// AnalyzeClip showing its progress on `progress` (labelled with the clip's file name);
+/// the progress line is ended before returning.
+Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::path& path,
+                                                       const video::ClipAnalysisOptions& options,
+                                                       VideoProgress& progress);
 
 /// Writes `dir`/<trial id>.png for every trial of `analysis` whose times came from its
 /// video (failed ones included, when their video analysis got through); one line per file
