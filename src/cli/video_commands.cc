@@ -51,10 +51,6 @@ Result<std::pair<double, double>> ParseRestWindow(const std::string& text) {
   }
 }
 
-std::string Milliseconds(int64_t ns) {
-  return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
-}
-
 // the analysis for people
 void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
   out << analysis.video_path.string() << " (" << analysis.width_px << "x" << analysis.height_px
@@ -77,12 +73,13 @@ void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
   }
   if (Result<EventTimes> events = analysis.Events(); events.ok()) {
     out << "events: LED on " << FormatSeconds(events->led_on_ns, 4) << " s +- "
-        << Milliseconds(events->led_on_uncertainty_ns) << ", liftoff ("
+        << FormatMilliseconds(events->led_on_uncertainty_ns) << ", liftoff ("
         << video::LiftoffInstantName(analysis.liftoff_instant) << ") "
         << FormatSeconds(events->liftoff_ns, 4) << " s +- "
-        << Milliseconds(events->liftoff_uncertainty_ns) << "; interval LED on -> liftoff "
+        << FormatMilliseconds(events->liftoff_uncertainty_ns) << "; interval LED on -> liftoff "
         << FormatSeconds(events->liftoff_ns - events->led_on_ns, 4) << " s +- "
-        << Milliseconds(events->led_on_uncertainty_ns + events->liftoff_uncertainty_ns) << '\n';
+        << FormatMilliseconds(events->led_on_uncertainty_ns + events->liftoff_uncertainty_ns)
+        << '\n';
   }
   for (const std::string& warning : analysis.warnings) out << "warning: " << warning << '\n';
 }

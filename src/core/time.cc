@@ -68,6 +68,13 @@ Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns) {
   return static_cast<int64_t>(negative ? -ns : ns);
 }
 
+std::string FormatMilliseconds(int64_t ns, int decimals) {
+  assert(decimals >= 0 && decimals <= 9);
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.*f ms", decimals, 1e-6 * static_cast<double>(ns));
+  return buffer;
+}
+
 std::string FormatSeconds(int64_t ns, int decimals) {
   assert(decimals >= 0 && decimals <= 9);
   char buffer[48];

@@ -20,7 +20,6 @@
 namespace liftoff::video {
 namespace {
 
-using internal::Milliseconds;
 
 using nlohmann::json;
 
@@ -329,11 +328,11 @@ std::string ClipAnalysis::Brief() const {
   std::string text = video_path.filename().string() + ": ";
   if (!led.pulses.empty()) {
     text += "LED on " + FormatSeconds(led_on().on_ns, 4) + " s +- " +
-            Milliseconds(led_on().on_uncertainty_ns);
+            FormatMilliseconds(led_on().on_uncertainty_ns);
   }
   if (const TimedEvent* lifted = liftoff()) {
     text += ", liftoff " + FormatSeconds(lifted->t_ns, 4) + " s +- " +
-            Milliseconds(lifted->uncertainty_ns);
+            FormatMilliseconds(lifted->uncertainty_ns);
     if (liftoff_instant == LiftoffInstant::kOnset) {
       text += " (onset)";
     } else if (foot->px_per_mm > 0) {
@@ -465,7 +464,7 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
   }
   if (timing.irregular_frames > 0) {
     analysis.warnings.push_back("frames: " + Plural(timing.irregular_frames, "interval") +
-                                " off the usual " + Milliseconds(timing.median_interval_ns));
+                                " off the usual " + FormatMilliseconds(timing.median_interval_ns));
   }
 
   // the LED, then the rest window from its first switch-on, then the foot

@@ -12,19 +12,12 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
-#include "liftoff/core/text.h"
-
 namespace liftoff::video::internal {
 
 // "600x400+80x90": position then size, as the headers' messages spell a region.
 inline std::string RectText(const cv::Rect& rect) {
   return std::to_string(rect.x) + "x" + std::to_string(rect.y) + "+" + std::to_string(rect.width) +
          "x" + std::to_string(rect.height);
-}
-
-// "4.2 ms": a duration in ns as milliseconds, one decimal.
-inline std::string Milliseconds(int64_t ns) {
-  return FormatFixed(1e-6 * static_cast<double>(ns), 1) + " ms";
 }
 
 // The median of values[0, count) (reordered; the mean of the middle two for an even

@@ -109,6 +109,12 @@ TEST(TimeConversions, NsFromSecondsSaturatesInsteadOfOverflowing) {
   EXPECT_EQ(NsFromSeconds(kMaxTimeSeconds), 1'000'000 * kSecond);
 }
 
+TEST(FormatMilliseconds, PrintsMillisecondsWithTheUnit) {
+  EXPECT_EQ(FormatMilliseconds(4'249'000), "4.2 ms");
+  EXPECT_EQ(FormatMilliseconds(16'666'667, 3), "16.667 ms");
+  EXPECT_EQ(FormatMilliseconds(-1'500'000, 0), "-2 ms");
+}
+
 TEST(FormatSeconds, PrintsRequestedDecimals) {
   EXPECT_EQ(FormatSeconds(1'500'000'000), "1.500");
   EXPECT_EQ(FormatSeconds(-250'000'000, 2), "-0.25");

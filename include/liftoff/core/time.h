@@ -43,6 +43,8 @@ Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns);
 
 /// "12.345678901" style: seconds with `decimals` digits after the point (0..9).
 std::string FormatSeconds(int64_t ns, int decimals = 3);
+/// "4.2 ms": a duration as milliseconds with `decimals` digits (0..9) and the unit.
+std::string FormatMilliseconds(int64_t ns, int decimals = 1);
 
 /// The current host time, nanoseconds since the Unix epoch (CLOCK_REALTIME).
 int64_t HostNowNs();
