@@ -100,8 +100,8 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   auto calibration = ChooseCalibration(
       command.calibration, manifest->calibration_path.value_or(std::filesystem::path()));
   if (!calibration.ok()) return ReportError(calibration.status(), err);
-  std::optional<stats::SimResults> sim;
-  if (!command.sim_path.empty()) {
+  std::optional<stats::SimResults> sim = command.sim_results;
+  if (!sim && !command.sim_path.empty()) {
     auto loaded = stats::LoadSimResults(command.sim_path);
     if (!loaded.ok()) return ReportError(loaded.status(), err);
     sim = std::move(loaded).value();

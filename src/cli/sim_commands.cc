@@ -372,29 +372,6 @@ void PrintSweep(const sim::SweepResult& sweep, std::ostream& out) {
   for (const std::string& note : notes) out << "- " << note << "\n";
 }
 
-// The results where the table command can read them: the -o file, else a scratch file.
-class ResultsFile {
- public:
-  explicit ResultsFile(std::filesystem::path path) : path_(std::move(path)) {
-    if (!path_.empty()) return;
-    path_ = std::filesystem::temp_directory_path() /
-            ("liftoff-sim-results-" + std::to_string(::getpid()) + ".json");
-    scratch_ = true;
-  }
-  ~ResultsFile() {
-    std::error_code ignored;
-    if (scratch_) std::filesystem::remove(path_, ignored);
-  }
-  ResultsFile(const ResultsFile&) = delete;
-  ResultsFile& operator=(const ResultsFile&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  bool scratch() const { return scratch_; }
-
- private:
-  std::filesystem::path path_;
-  bool scratch_ = false;
-};
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -733,14 +710,14 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
 
   // the results file, then what to print
   const std::string overrides = DescribeOverrides(command.experiment);
-  const stats::SimResults results =
+  stats::SimResults results =
       SimResultsFromSweep(*sweep, "liftoff sim sweep" + (overrides.empty() ? "" : " " + overrides));
+  results.source = command.output_path.empty() ? "this sweep" : command.output_path.string();
   const json document = stats::SimResultsToJson(results);
-  ResultsFile results_file(command.output_path);
-  if (!command.output_path.empty() || !command.hardware_path.empty()) {
-    const Status written = WriteJsonFile(results_file.path(), document);
+  if (!command.output_path.empty()) {
+    const Status written = WriteJsonFile(command.output_path, document);
     if (!written.ok()) return ReportError(written, err);
-    if (!results_file.scratch()) err << "wrote " << results_file.path().string() << '\n';
+    err << "wrote " << command.output_path.string() << '\n';
   }
   if (command.json) {
     out << document.dump(2) << '\n';
@@ -756,7 +733,7 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
   table.lookup = command.lookup;
   table.format = command.format;
   table.tables = "feet";
-  table.sim_path = results_file.path();
+  table.sim_results = std::move(results);
   if (!command.json) out << '\n';
   return RunTable(table, out, err);
 }

@@ -365,6 +365,11 @@ bool LiftoffRecorder::CanStop() const {
                                 first_liftoff_abs_rad_ + options_.stop_after_liftoff_rad;
 }
 
+bool LiftoffRecorder::Decided() const {
+  if (!not_standing_reason_.empty()) return true;
+  return first_foot_.has_value() && feet_[static_cast<size_t>(options_.foot)].lifted;
+}
+
 ExperimentResult LiftoffRecorder::Finish() const {
   ExperimentResult result;
   result.foot = options_.foot;
@@ -464,8 +469,7 @@ Result<ExperimentResult> RunExperimentWithProgress(const ModelDescription& descr
     report(t_s);
     if (control.stop_once_decided) {
       // settled: the target lifted while standing, or the standing check failed
-      const ExperimentResult so_far = recorder.Finish();
-      if (so_far.status == RunStatus::kDidNotStand || so_far.TargetLiftoffRad()) break;
+      if (recorder.Decided()) break;
     }
   }
   ExperimentResult result = recorder.Finish();

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "liftoff/core/status.h"
+#include "liftoff/stats/sim_results.h"
 
 namespace liftoff::cli {
 
@@ -56,6 +57,9 @@ struct TableCommand {
   std::string tables = "both";
   /// Simulation results JSON (docs/formats.md) for the simulation columns; empty: blank.
   std::filesystem::path sim_path;
+  /// Simulation results already in memory (`liftoff sim sweep --hardware`); win over
+  /// sim_path.
+  std::optional<stats::SimResults> sim_results;
   /// Write the tables here instead of `out`.
   std::filesystem::path output_path;
   /// The per-foot hardware-vs-simulation plot (SVG) to write; empty: none.

@@ -288,6 +288,10 @@ class LiftoffRecorder {
   /// True once stopping early loses nothing the options ask for (the first foot lifted
   /// and |angle| went stop_after_liftoff_rad past it).
   bool CanStop() const;
+  /// True once the targeted foot's outcome is settled: the robot failed the standing
+  /// check, or the targeted foot lifted (RunControl::stop_once_decided). Cheap: no
+  /// result is built.
+  bool Decided() const;
   /// The outcome so far (call after the last Add).
   ExperimentResult Finish() const;
 
