@@ -1,610 +1,103 @@
 #include "liftoff/video/foot_tracker.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "patch_registration.h"
+#include "rise_fit.h"
 #include "video_util.h"
 
 namespace liftoff::video {
 namespace {
 
 using internal::MedianOf;
+using internal::PatchMatch;
+using internal::PatchTemplate;
 using internal::RectText;
 
-// Search radius around the previous frame's shift, px (the foot and the shake move less
-// than this between two frames); beyond it a full search runs.
-constexpr int kLocalSearchPx = 3;
-// Largest camera shake searched on the reference patches, px.
-constexpr int kMaxShakePx = 12;
-// Half-width of the foot's measured columns, fraction of the foot's width.
-constexpr double kColumnsHalfFraction = 0.15;
-// The template ends this far above the foot's bottom edge, px (the ground and the shadow
-// below the edge change as the foot rises; compression and blur spread them ~2 px).
-constexpr double kTemplateBottomMarginPx = 2.0;
-// Below this match quality a local search is retried as a full search.
-constexpr double kRetryQuality = 0.6;
+// The work image: the foot region and a margin of this fraction of its size on every side
+// (static ground for the camera's shake), scaled down so that the region's smaller side is
+// at most kWorkRegionPx (registration keeps its sub-pixel precision; large regions cost
+// no more than small ones).
+constexpr double kMarginFraction = 0.3;
+constexpr double kWorkRegionPx = 64.0;
+// Patch side in work px, and the spacing of candidate patches.
+constexpr int kPatchPx = 9;
+constexpr int kPatchStridePx = 3;
+// Patches kept: inside the foot region, and in the margin around it.
+constexpr size_t kRegionPatches = 56;
+constexpr size_t kMarginPatches = 24;
+// Frames averaged into the templates (noise of a single frame would be in every sample).
+constexpr int kTemplateFrames = 4;
+// A patch whose residual exceeds this multiple of its running typical residual (plus a
+// floor in grey levels) is not measured in that frame; after kLostFrames such frames in a
+// row it is dropped.
+constexpr double kResidualFactor = 2.5;
+constexpr double kResidualFloor = 6.0;
+constexpr int kLostFrames = 8;
+// Largest gain change accepted for a patch (a patch that needs more is not the same thing).
+constexpr double kMaxGain = 0.5;
+// A patch is the foot's when its final rise is at least this fraction of the foot's largest
+// (patches on the foot's border with the ground move only in part).
+constexpr double kFootFraction = 0.8;
+// The fit ends where the rising curve stays above this many thresholds (at least
+// kFitTopPx px): high enough to pin the curvature and average over a codec's stepwise
+// updates, low enough for the model's two terms.
+constexpr double kFitTopThresholds = 8.0;
+constexpr double kFitTopPx = 4.0;
+// A key frame this soon after the fit's top extends the fit to it, s.
+constexpr double kKeyframeReachS = 1.5;
+// Weight of samples within a codec's possible lag below the model, and the least lag
+// allowed for when frames are predicted (internal::RiseFitOptions).
+constexpr double kLagWeight = 0.02;
+constexpr double kMinLagPx = 0.3;
+// A catch-up is partial: the lag allowed for is this multiple of the largest one seen.
+constexpr double kLagBoundFactor = 1.5;
+// Longest stretch of rest fitted before the rise, s.
+constexpr double kFitRestS = 3.0;
+// The curve's running median for the search, s either side.
+constexpr double kSmoothHalfS = 0.15;
+// Patches that end within this of their rest are ground; the foot's patches must agree
+// with their median within 3 typical deviations plus this, px.
+constexpr double kGroundTolerancePx = 0.5;
+constexpr double kCoherencePx = 0.15;
+// A lift is sustained for this long (and this many frames at least), s; the rest before
+// it counts as reached after kRestingS flat.
+constexpr double kSustainS = 0.5;
+constexpr size_t kSustainFrames = 5;
+constexpr double kRestingS = 0.5;
+// Weak evidence: fewer foot (ground) patches than these, a curve noisier than this
+// fraction of the threshold, an instant more uncertain than this, a clip ending fewer
+// thresholds up than this.
+constexpr size_t kFewFootPatches = 3;
+constexpr size_t kFewGroundPatches = 3;
+constexpr double kNoisyFraction = 0.5;
+constexpr double kWideUncertaintyS = 0.25;
+constexpr double kShortRiseThresholds = 3.0;
 // Scale uncertainty assumed for an estimated px_per_mm (a fraction).
 constexpr double kEstimatedScaleFraction = 0.03;
-// A located foot wider than this fraction of its region draws a warning.
-constexpr double kWideFootFraction = 0.8;
-// The hinge is fitted up to where the foot is this many thresholds above rest: far enough
-// to average over a codec's stepwise updates of slow sub-pixel motion (H.264 lets the
-// decoded foot lag by up to ~0.4 px, then catch up, every ~10 frames).
-constexpr double kFitEndThresholds = 5.0;
 
-int Round(double value) { return static_cast<int>(std::lround(value)); }
-int Floor(double value) { return static_cast<int>(std::floor(value)); }
-int Ceil(double value) { return static_cast<int>(std::ceil(value)); }
 int64_t RoundNs(double value) { return static_cast<int64_t>(std::llround(value)); }
-size_t Index(int value) { return static_cast<size_t>(value); }
-
+double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 std::string MsText(int64_t t_ns) { return FormatFixed(static_cast<double>(t_ns) / 1e6, 1); }
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// ---------------------------------------------------------------------------------------
-// profiles
-
-// Pixel weights that cover the continuous interval [lo, hi] (pixel i covers
-// [i - 0.5, i + 0.5)), normalised to sum 1.
-struct AxisWindow {
-  int first = 0;
-  std::vector<float> weights;
-  int last() const { return first + static_cast<int>(weights.size()) - 1; }
-};
-
-AxisWindow MakeWindow(double lo, double hi) {
-  AxisWindow window;
-  window.first = Floor(lo + 0.5);
-  const int last = std::max(window.first, Ceil(hi + 0.5) - 1);
-  double sum = 0;
-  for (int i = window.first; i <= last; ++i) {
-    const double w = std::max(0.0, std::min(hi, i + 0.5) - std::max(lo, i - 0.5));
-    window.weights.push_back(static_cast<float>(w));
-    sum += w;
-  }
-  if (sum <= 0) {
-    window.weights.assign(1, 1.0f);
-    return window;
-  }
-  for (float& w : window.weights) w = static_cast<float>(static_cast<double>(w) / sum);
-  return window;
-}
-
-// The window moved inside [0, size) when it pokes out (same weights).
-AxisWindow ClampWindow(AxisWindow window, int size) {
-  const int count = static_cast<int>(window.weights.size());
-  window.first = std::clamp(window.first, 0, std::max(0, size - count));
-  return window;
-}
-
-// Values at integer positions first .. first + length - 1, `channels` interleaved.
-struct Profile {
-  int first = 0;
-  int length = 0;
-  int channels = 1;
-  std::vector<float> values;
-  int last() const { return first + length - 1; }
-  const float* at(int position) const {
-    return values.data() + Index((position - first) * channels);
-  }
-};
-
-// Mean over `columns` of rows [row_first, row_first + rows): B, G, R per row (channels 3)
-// or B + G + R (channels 1). Rows and columns must lie inside the image.
-void ColumnMean(const cv::Mat& bgr, const AxisWindow& columns, int row_first, int rows,
-                int channels, Profile& out) {
-  out.first = row_first;
-  out.length = std::max(0, rows);
-  out.channels = channels;
-  out.values.assign(Index(out.length * channels), 0.0f);
-  const size_t count = columns.weights.size();
-  for (int r = 0; r < out.length; ++r) {
-    const uint8_t* pixel = bgr.ptr<uint8_t>(row_first + r) + Index(columns.first * 3);
-    float b = 0, g = 0, red = 0;
-    for (size_t c = 0; c < count; ++c) {
-      const float w = columns.weights[c];
-      b += w * pixel[3 * c];
-      g += w * pixel[3 * c + 1];
-      red += w * pixel[3 * c + 2];
-    }
-    float* v = out.values.data() + Index(r * channels);
-    if (channels == 3) {
-      v[0] = b;
-      v[1] = g;
-      v[2] = red;
-    } else {
-      v[0] = b + g + red;
-    }
-  }
-}
-
-// Mean over `rows` of columns [col_first, col_first + cols), B + G + R.
-void RowMean(const cv::Mat& bgr, const AxisWindow& rows, int col_first, int cols, Profile& out) {
-  out.first = col_first;
-  out.length = std::max(0, cols);
-  out.channels = 1;
-  out.values.assign(Index(out.length), 0.0f);
-  for (size_t r = 0; r < rows.weights.size(); ++r) {
-    const float w = rows.weights[r];
-    const uint8_t* pixel =
-        bgr.ptr<uint8_t>(rows.first + static_cast<int>(r)) + Index(col_first * 3);
-    for (int c = 0; c < out.length; ++c) {
-      const uint8_t* p = pixel + Index(3 * c);
-      out.values[Index(c)] += w * static_cast<float>(p[0] + p[1] + p[2]);
-    }
-  }
-}
-
-// ---------------------------------------------------------------------------------------
-// registration of a profile against its template
-
-struct Match {
-  double shift = 0;    // d: current(y) = gain * template(y - d) + offset
-  double quality = 0;  // fraction of the current profile's variance the fit explains
-  bool found = false;
-  bool at_limit = false;  // the best integer shift is an end of the searched range
-};
-
-// Solves the symmetric 3 x 3 system a x = b; false when singular.
-bool Solve3(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
-            std::array<double, 3>& x) {
-  for (int col = 0; col < 3; ++col) {
-    int pivot = col;
-    for (int row = col + 1; row < 3; ++row) {
-      if (std::abs(a[Index(row)][Index(col)]) > std::abs(a[Index(pivot)][Index(col)])) pivot = row;
-    }
-    if (std::abs(a[Index(pivot)][Index(col)]) < 1e-12) return false;
-    std::swap(a[Index(col)], a[Index(pivot)]);
-    std::swap(b[Index(col)], b[Index(pivot)]);
-    for (int row = col + 1; row < 3; ++row) {
-      const double factor = a[Index(row)][Index(col)] / a[Index(col)][Index(col)];
-      for (int k = col; k < 3; ++k) a[Index(row)][Index(k)] -= factor * a[Index(col)][Index(k)];
-      b[Index(row)] -= factor * b[Index(col)];
-    }
-  }
-  for (int row = 2; row >= 0; --row) {
-    double sum = b[Index(row)];
-    for (int k = row + 1; k < 3; ++k) sum -= a[Index(row)][Index(k)] * x[Index(k)];
-    x[Index(row)] = sum / a[Index(row)][Index(row)];
-  }
-  return true;
-}
-
-// Finds the shift d with current(y) ~ gain * template(y - d) + offset, the template
-// interpolated linearly between positions, the integer part searched in [n_lo, n_hi].
-// Coarse: the integer shift of best normalised correlation over at least `min_overlap`
-// positions. Fine: on each pixel interval next to it, current(y) = alpha template(y - m) +
-// beta template(y - m - 1) + offset is linear, so least squares gives the fraction
-// beta / (alpha + beta) in closed form; the best fit among the two intervals and the three
-// integer shifts wins.
-Match Register(const Profile& templ, const Profile& current, int n_lo, int n_hi, int min_overlap) {
-  const int channels = templ.channels;
-  Match match;
-  double best_score = -2;
-  int best_n = 0;
-  for (int n = n_lo; n <= n_hi; ++n) {
-    const int y0 = std::max(templ.first + n, current.first);
-    const int y1 = std::min(templ.last() + n, current.last());
-    if (y1 - y0 + 1 < min_overlap) continue;
-    double st = 0, sp = 0, stt = 0, spp = 0, stp = 0;
-    const float* t = templ.at(y0 - n);
-    const float* p = current.at(y0);
-    const int count = (y1 - y0 + 1) * channels;
-    for (int i = 0; i < count; ++i) {
-      const double tv = t[i], pv = p[i];
-      st += tv;
-      sp += pv;
-      stt += tv * tv;
-      spp += pv * pv;
-      stp += tv * pv;
-    }
-    const double var_t = stt - st * st / count, var_p = spp - sp * sp / count;
-    if (var_t <= 1e-6 * count || var_p <= 1e-6 * count) continue;
-    const double score = (stp - st * sp / count) / std::sqrt(var_t * var_p);
-    if (score > best_score) {
-      best_score = score;
-      best_n = n;
-    }
-  }
-  if (best_score < -1) return match;
-  match.at_limit = best_n == n_lo || best_n == n_hi;
-
-  // rows where template(y - n - 1) .. template(y - n + 1) all exist
-  const int y0 = std::max(templ.first + best_n + 1, current.first);
-  const int y1 = std::min(templ.last() + best_n - 1, current.last());
-  if (y1 - y0 + 1 < std::max(3, min_overlap - 2)) {
-    match.shift = best_n;
-    match.quality = std::max(0.0, best_score);
-    match.found = true;
-    return match;
-  }
-  const int count = (y1 - y0 + 1) * channels;
-  const float* p = current.at(y0);
-  double sp = 0, spp = 0;
-  for (int i = 0; i < count; ++i) {
-    const double pv = p[i];
-    sp += pv;
-    spp += pv * pv;
-  }
-  const double sst = std::max(1e-9, spp - sp * sp / count);
-
-  // integer shifts: current = a * template(y - k) + c
-  double best_sse = std::numeric_limits<double>::infinity();
-  double best_shift = best_n;
-  for (int k = best_n - 1; k <= best_n + 1; ++k) {
-    const float* t = templ.at(y0 - k);
-    double st = 0, stt = 0, stp = 0;
-    for (int i = 0; i < count; ++i) {
-      const double tv = t[i], pv = p[i];
-      st += tv;
-      stt += tv * tv;
-      stp += tv * pv;
-    }
-    const double var_t = stt - st * st / count;
-    if (var_t <= 0) continue;
-    const double cov = stp - st * sp / count;
-    if (cov <= 0) continue;
-    const double sse = sst - cov * cov / var_t;
-    if (sse < best_sse) {
-      best_sse = sse;
-      best_shift = k;
-    }
-  }
-  // pixel intervals [m, m + 1]: current = alpha template(y - m) + beta template(y - m - 1) + c
-  for (int m = best_n - 1; m <= best_n; ++m) {
-    const float* a = templ.at(y0 - m);
-    const float* b = templ.at(y0 - m - 1);
-    double saa = 0, sab = 0, sbb = 0, sa = 0, sb = 0, sap = 0, sbp = 0;
-    for (int i = 0; i < count; ++i) {
-      const double av = a[i], bv = b[i], pv = p[i];
-      saa += av * av;
-      sab += av * bv;
-      sbb += bv * bv;
-      sa += av;
-      sb += bv;
-      sap += av * pv;
-      sbp += bv * pv;
-    }
-    std::array<double, 3> x{};
-    if (!Solve3({{{saa, sab, sa}, {sab, sbb, sb}, {sa, sb, static_cast<double>(count)}}},
-                {sap, sbp, sp}, x)) {
-      continue;
-    }
-    const double gain = x[0] + x[1];
-    if (gain <= 0) continue;
-    const double fraction = x[1] / gain;
-    if (fraction <= 0 || fraction >= 1) continue;
-    const double sse = spp - (x[0] * sap + x[1] * sbp + x[2] * sp);
-    if (sse < best_sse) {
-      best_sse = sse;
-      best_shift = m + fraction;
-    }
-  }
-  if (!std::isfinite(best_sse)) return match;
-  match.shift = best_shift;
-  match.quality = std::clamp(1.0 - best_sse / sst, 0.0, 1.0);
-  match.found = true;
-  return match;
-}
-
-// ---------------------------------------------------------------------------------------
-// locating the foot in the first frame
-
-// A region's B + G + R per pixel, rows x columns (row-major).
-struct GreyPatch {
-  cv::Rect rect;
-  std::vector<float> grey;
-  float at(int x, int y) const { return grey[Index((y - rect.y) * rect.width + (x - rect.x))]; }
-};
-
-GreyPatch GreyOf(const cv::Mat& bgr, const cv::Rect& rect) {
-  GreyPatch patch;
-  patch.rect = rect;
-  patch.grey.resize(Index(rect.area()));
-  for (int y = 0; y < rect.height; ++y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(rect.y + y) + Index(rect.x * 3);
-    for (int x = 0; x < rect.width; ++x) {
-      patch.grey[Index(y * rect.width + x)] =
-          static_cast<float>(p[3 * x] + p[3 * x + 1] + p[3 * x + 2]);
-    }
-  }
-  return patch;
-}
-
-// The nominal tape colours of the synthetic scenes, BGR (A blue, B orange, C purple, D red).
-cv::Vec3d NominalTapeBgr(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return {200, 80, 20};
-    case Foot::kB: return {20, 140, 255};
-    case Foot::kC: return {160, 40, 130};
-    case Foot::kD: return {30, 30, 210};
-  }
-  return {128, 128, 128};
-}
-
-// How much a pixel looks like the tape: its chroma along the tape's hue minus half the
-// tape's saturation times its brightness (grey levels; > 0 on the tape, < 0 on greys and
-// on weakly saturated surfaces of the same hue such as wood).
-struct TapeScorer {
-  cv::Vec3d hue;  // unit chroma direction
-  double saturation_cut = 0;
-  explicit TapeScorer(Foot foot) {
-    const cv::Vec3d tape = NominalTapeBgr(foot);
-    const double mean = (tape[0] + tape[1] + tape[2]) / 3;
-    const cv::Vec3d chroma = tape - cv::Vec3d::all(mean);
-    hue = chroma / cv::norm(chroma);
-    saturation_cut = 0.5 * cv::norm(chroma) / mean;
-  }
-  double operator()(const uint8_t* p) const {
-    const double mean = (p[0] + p[1] + p[2]) / 3.0;
-    const double along = (p[0] - mean) * hue[0] + (p[1] - mean) * hue[1] + (p[2] - mean) * hue[2];
-    return along - saturation_cut * mean;
-  }
-};
-
-// An edge in a 1-D signal: where the signed gradient peaks, refined as the centroid of the
-// gradient around the peak (exact for an area-sampled step), and its strength.
-struct Edge {
-  double position = 0;
-  double strength = 0;
-  bool found = false;
-};
-
-// Gradient g[i] = v[i + 1] - v[i] sits at position first + i + 0.5.
-Edge CentroidEdge(const std::vector<double>& values, int first, int peak, double sign) {
-  Edge edge;
-  double sum = 0, moment = 0;
-  const int count = static_cast<int>(values.size());
-  for (int i = std::max(0, peak - 2); i <= std::min(count - 2, peak + 2); ++i) {
-    const double g = sign * (values[Index(i + 1)] - values[Index(i)]);
-    if (g <= 0) continue;
-    sum += g;
-    moment += g * (first + i + 0.5);
-  }
-  if (sum <= 0) return edge;
-  edge.position = moment / sum;
-  edge.strength = sign * (values[Index(peak + 1)] - values[Index(peak)]);
-  edge.found = true;
-  return edge;
-}
-
-// The strongest gradient of the given sign among gradients i in [lo, hi] (indices into
-// `values`); sign 0: either sign (the chosen one is returned in `sign`).
-int StrongestGradient(const std::vector<double>& values, int lo, int hi, double& sign) {
-  int best = -1;
-  double best_value = 0;
-  for (int i = std::max(0, lo); i <= std::min(static_cast<int>(values.size()) - 2, hi); ++i) {
-    const double g = values[Index(i + 1)] - values[Index(i)];
-    const double v = sign == 0 ? std::abs(g) : sign * g;
-    if (v > best_value) {
-      best_value = v;
-      best = i;
-    }
-  }
-  if (best >= 0 && sign == 0) sign = values[Index(best + 1)] - values[Index(best)] > 0 ? 1 : -1;
-  return best;
-}
-
-// The first gradient of the given sign, scanning [lo, hi] upwards in index, that reaches
-// 40 % of the strongest one there: where the foot ends (the ground's texture and the
-// shadow's flank below it may be stronger, but they come after it).
-int FirstStrongGradient(const std::vector<double>& values, int lo, int hi, double sign) {
-  lo = std::max(0, lo);
-  hi = std::min(static_cast<int>(values.size()) - 2, hi);
-  double strongest = 0;
-  for (int i = lo; i <= hi; ++i) {
-    strongest = std::max(strongest, sign * (values[Index(i + 1)] - values[Index(i)]));
-  }
-  if (strongest <= 0) return -1;
-  for (int i = lo; i <= hi; ++i) {
-    if (sign * (values[Index(i + 1)] - values[Index(i)]) >= 0.4 * strongest) return i;
-  }
-  return -1;
-}
-
-struct FootGeometry {
-  double center_x = 0;
-  double width = 0;
-  double bottom = 0;
-  double polarity = 1;  // sign of (ground - foot) brightness
-  bool by_tape = false;
-};
-
-// Left and right edges of the foot in the mean over `rows` of columns [x0, x1]: the
-// strongest gradient left of `center` and the strongest of the opposite sign right of it.
-bool SideEdges(const cv::Mat& bgr, int row_lo, int row_hi, int x0, int x1, double center,
-               double& left, double& right, double& polarity) {
-  row_lo = std::max(row_lo, 0);
-  row_hi = std::min(row_hi, bgr.rows - 1);
-  if (row_hi < row_lo || x1 - x0 < 6) return false;
-  const AxisWindow rows = MakeWindow(row_lo - 0.5, row_hi + 0.5);
-  Profile profile;
-  RowMean(bgr, rows, x0, x1 - x0 + 1, profile);
-  const std::vector<double> values(profile.values.begin(), profile.values.end());
-  const int split = Round(center) - x0;
-  double left_sign = 0;
-  const int l = StrongestGradient(values, 0, split - 1, left_sign);
-  if (l < 0) return false;
-  double right_sign = -left_sign;
-  const int r = StrongestGradient(values, split, static_cast<int>(values.size()) - 2, right_sign);
-  if (r < 0) return false;
-  const Edge le = CentroidEdge(values, x0, l, left_sign);
-  const Edge re = CentroidEdge(values, x0, r, right_sign);
-  if (!le.found || !re.found || re.position - le.position < 4) return false;
-  left = le.position;
-  right = re.position;
-  polarity = right_sign;  // foot -> ground going right
-  return true;
-}
-
-// The tape band in the region: its rows and its left and right ends.
-bool TapeBand(const cv::Mat& bgr, const cv::Rect& region, Foot foot, double& left, double& right,
-              int& band_top, int& band_bottom) {
-  const TapeScorer scorer(foot);
-  std::vector<double> score(Index(region.area()));
-  std::vector<int> row_count(Index(region.height), 0);
-  for (int y = 0; y < region.height; ++y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(region.y + y) + Index(region.x * 3);
-    for (int x = 0; x < region.width; ++x) {
-      const double s = scorer(p + 3 * x);
-      score[Index(y * region.width + x)] = s;
-      if (s > 0) ++row_count[Index(y)];
-    }
-  }
-  const int best_row =
-      static_cast<int>(std::max_element(row_count.begin(), row_count.end()) - row_count.begin());
-  if (row_count[Index(best_row)] < 3) return false;
-  // the band: the run of rows around the best one with at least half its count
-  const int half = (row_count[Index(best_row)] + 1) / 2;
-  band_top = best_row;
-  band_bottom = best_row;
-  while (band_top > 0 && row_count[Index(band_top - 1)] >= half) --band_top;
-  while (band_bottom + 1 < region.height && row_count[Index(band_bottom + 1)] >= half) {
-    ++band_bottom;
-  }
-  // the ends: half-level crossings of the mean score over the band's rows
-  std::vector<double> columns(Index(region.width), 0.0);
-  for (int y = band_top; y <= band_bottom; ++y) {
-    for (int x = 0; x < region.width; ++x) columns[Index(x)] += score[Index(y * region.width + x)];
-  }
-  const int peak =
-      static_cast<int>(std::max_element(columns.begin(), columns.end()) - columns.begin());
-  const double top_level = columns[Index(peak)];
-  int l = peak, r = peak;
-  while (l > 0 && columns[Index(l - 1)] > 0.5 * top_level) --l;
-  while (r + 1 < region.width && columns[Index(r + 1)] > 0.5 * top_level) ++r;
-  if (l == 0 || r == region.width - 1) return false;  // cut by the region: not the band's ends
-  // linear interpolation of the half level between the columns either side of each end
-  const auto crossing = [&](int inside, int outside) {
-    const double vi = columns[Index(inside)], vo = columns[Index(outside)];
-    const double level = 0.5 * top_level;
-    const double f = vi == vo ? 0.5 : (vi - level) / (vi - vo);
-    return region.x + inside + f * (outside - inside);
-  };
-  left = crossing(l, l - 1);
-  right = crossing(r, r + 1);
-  band_top += region.y;
-  band_bottom += region.y;
-  return right - left >= 4;
-}
-
-// Bottom edge of the foot in the mean over columns [center - half, center + half]: the
-// first strong foot-to-ground edge (sign `polarity` going down) among rows [lo, hi].
-Edge BottomEdge(const cv::Mat& bgr, double center, double half, int lo, int hi, double polarity) {
-  Edge edge;
-  lo = std::max(lo, 2);
-  hi = std::min(hi, bgr.rows - 3);
-  if (hi <= lo) return edge;
-  const AxisWindow columns = ClampWindow(MakeWindow(center - half, center + half), bgr.cols);
-  Profile profile;
-  ColumnMean(bgr, columns, lo - 2, hi - lo + 5, 1, profile);
-  const std::vector<double> values(profile.values.begin(), profile.values.end());
-  const int first = FirstStrongGradient(values, 2, hi - lo + 2, polarity);
-  if (first < 0) return edge;
-  // the edge's position: the centroid of this gradient and the one before it (an
-  // area-sampled edge spreads over two), not of the ones after (the shadow's flank)
-  const double g0 = std::max(0.0, polarity * (values[Index(first)] - values[Index(first - 1)]));
-  const double g1 = polarity * (values[Index(first + 1)] - values[Index(first)]);
-  edge.position = lo - 2 + first + 0.5 - g0 / (g0 + g1);
-  edge.strength = g1;
-  edge.found = true;
-  return edge;
-}
-
-// ---------------------------------------------------------------------------------------
-// the shake references
-
-struct ReferencePatch {
-  cv::Rect rect;       // in the first frame
-  Profile vertical;    // column mean (B + G + R) of its rows
-  Profile horizontal;  // row mean of its columns
-  double dx = 0, dy = 0;
-  double quality = 0;
-};
-
-// Texture of a patch for vertical and horizontal registration: the mean squared gradient
-// of its column-mean and row-mean profiles, (B + G + R)^2 per px^2.
-std::pair<double, double> PatchTexture(const GreyPatch& grey, const cv::Rect& rect) {
-  std::vector<double> rows(Index(rect.height), 0.0), cols(Index(rect.width), 0.0);
-  for (int y = 0; y < rect.height; ++y) {
-    for (int x = 0; x < rect.width; ++x) {
-      const double v = grey.at(rect.x + x, rect.y + y);
-      rows[Index(y)] += v / rect.width;
-      cols[Index(x)] += v / rect.height;
-    }
-  }
-  const auto energy = [](const std::vector<double>& values) {
-    double sum = 0;
-    for (size_t i = 0; i + 1 < values.size(); ++i) {
-      sum += (values[i + 1] - values[i]) * (values[i + 1] - values[i]);
-    }
-    return values.size() > 1 ? sum / static_cast<double>(values.size() - 1) : 0.0;
-  };
-  return {energy(rows), energy(cols)};
-}
-
-// Up to three textured patches of the scene near the foot that avoid the foot, the leg
-// above it, its shadow and the foot region (with room for the shake search). The shake is
-// their median, so one of them may hold something that moves (another foot, the LED).
-std::vector<cv::Rect> ChooseReferencePatches(const cv::Mat& bgr, const FootGeometry& foot,
-                                             const cv::Rect& foot_roi) {
-  const int size = std::clamp(Round(foot.width), 16, 48);
-  const int margin = kMaxShakePx + 2;
-  const cv::Rect usable(margin, margin, bgr.cols - 2 * margin, bgr.rows - 2 * margin);
-  const cv::Rect search =
-      cv::Rect(Floor(foot.center_x - 5 * foot.width), Floor(foot.bottom - 1.5 * foot.width),
-               Ceil(10 * foot.width), Ceil(4.5 * foot.width)) &
-      usable;
-  if (search.width < size || search.height < size) return {};
-  // the foot, its leg up to the top of the picture and its shadow, with room to spare
-  const cv::Rect foot_zone(Floor(foot.center_x - 1.15 * foot.width), 0, Ceil(2.3 * foot.width) + 1,
-                           Ceil(foot.bottom + 0.5 * foot.width));
-  const cv::Rect roi_zone(foot_roi.x - margin, foot_roi.y - margin, foot_roi.width + 2 * margin,
-                          foot_roi.height + 2 * margin);
-  const GreyPatch grey = GreyOf(bgr, search);
-
-  struct Candidate {
-    cv::Rect rect;
-    double score;
-  };
-  std::vector<Candidate> candidates;
-  const int stride = std::max(4, size / 2);
-  for (int y = search.y; y + size <= search.y + search.height; y += stride) {
-    for (int x = search.x; x + size <= search.x + search.width; x += stride) {
-      const cv::Rect rect(x, y, size, size);
-      if ((rect & foot_zone).area() > 0 || (rect & roi_zone).area() > 0) continue;
-      const auto [vertical, horizontal] = PatchTexture(grey, rect);
-      // grey levels (B + G + R): 0.5 levels per px of mean grey is too smooth to register
-      if (vertical < 2.25 || horizontal < 0.5) continue;
-      const double dx = x + size / 2.0 - foot.center_x;
-      const double dy = y + size / 2.0 - foot.bottom;
-      const double distance = std::sqrt(dx * dx + dy * dy);
-      candidates.push_back(
-          {rect, std::min(vertical, 4 * horizontal) / (1 + distance / (4 * foot.width))});
-    }
-  }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  std::vector<cv::Rect> chosen;
-  for (const Candidate& candidate : candidates) {
-    const bool overlaps = std::any_of(chosen.begin(), chosen.end(), [&](const cv::Rect& other) {
-      return (other & candidate.rect).area() > 0;
-    });
-    if (overlaps) continue;
-    chosen.push_back(candidate.rect);
-    if (chosen.size() == 3) break;
-  }
-  return chosen;
+// Median of the finite values; NaN for none.
+double FiniteMedian(std::vector<double>& values) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
 }
 
 }  // namespace
@@ -636,11 +129,6 @@ Status FootTracker::Options::Validate() const {
   if (rest_frames < 2) {
     return InvalidArgumentError("rest_frames: expected >= 2, got " + std::to_string(rest_frames));
   }
-  if (!reference_roi_px.empty() && (reference_roi_px.width < 8 || reference_roi_px.height < 8)) {
-    return InvalidArgumentError("reference_roi_px: expected empty or at least 8 x 8 px, got " +
-                                std::to_string(reference_roi_px.width) + " x " +
-                                std::to_string(reference_roi_px.height));
-  }
   if (!(compression_error_px >= 0) || !(compression_error_px <= 10)) {
     return InvalidArgumentError("compression_error_px: expected 0 .. 10, got " +
                                 FormatFixed(compression_error_px, 3));
@@ -648,10 +136,6 @@ Status FootTracker::Options::Validate() const {
   if (!(exposure_s >= 0) || !(exposure_s <= 10)) {
     return InvalidArgumentError("exposure_s: expected 0 (unknown) .. 10, got " +
                                 FormatFixed(exposure_s, 6));
-  }
-  if (confirm_frames < 1) {
-    return InvalidArgumentError("confirm_frames: expected >= 1, got " +
-                                std::to_string(confirm_frames));
   }
   if (!(min_quality >= 0 && min_quality <= 1)) {
     return InvalidArgumentError("min_quality: expected 0 .. 1, got " + FormatFixed(min_quality, 3));
@@ -673,237 +157,134 @@ std::string FootTrack::Brief() const {
 }
 
 // ---------------------------------------------------------------------------------------
-// the tracker
+// the tracker: every frame, every patch registered against its template
+
+namespace {
+
+struct TrackedPatch {
+  PatchTemplate templ;
+  // current top-left corner, work px; running typical residual, grey levels
+  cv::Point2d position_px;
+  double typical_residual = 0;
+  int misses = 0;
+  bool lost = false;
+  bool in_region = false;
+};
+
+}  // namespace
 
 struct FootTracker::Impl {
   Options options;
   Status options_status;
   int64_t rest_from_ns = 0, rest_to_ns = 0;
 
-  bool initialised = false;
   cv::Size frame_size;
-  FootGeometry foot;
-  double columns_half = 0;
-  Profile foot_template;
-  std::vector<ReferencePatch> patches;
-  std::vector<std::string> warnings;
-
-  // the last frame's state
-  double shake_x = 0, shake_y = 0;
-  double last_rise = 0, rise_before_last = 0;
-  int64_t last_t_ns = 0;
+  bool size_known = false;
+  cv::Rect work_px;  // frame px
+  double scale = 1;  // work px per frame px
+  cv::Rect region_work_px;  // the foot region in work px
+  cv::Mat work, accumulated;
+  int accumulated_frames = 0;
+  bool initialised = false;
+  std::vector<TrackedPatch> patches;
+  // frames x patches: each patch's rise since its template, frame px (up positive)
+  std::vector<float> rises;
+  size_t measured_from = 0;  // first sample with rises
   std::vector<HeightSample> samples;
-  Profile scratch;
+  int64_t last_t_ns = 0;
 
-  void Initialise(const cv::Mat& bgr);
-  void MeasureShake(const cv::Mat& bgr);
-  HeightSample MeasureFoot(const cv::Mat& bgr);
-  bool MeasurePatch(const cv::Mat& bgr, ReferencePatch& patch, int radius, bool& at_limit);
+  void ChooseWorkRegion(const cv::Size& size);
+  void MakeWorkImage(const cv::Mat& bgr);
+  void InitialisePatches();
+  void MeasurePatches();
 };
 
-void FootTracker::Impl::Initialise(const cv::Mat& bgr) {
+void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
   const cv::Rect& roi = options.foot_roi_px;
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const int roi_bottom = roi.y + roi.height - 1;
-  const int extra = Round(0.3 * roi.width);
-  const int x0 = std::max(0, roi.x - extra),
-            x1 = std::min(bgr.cols - 1, roi.x + roi.width - 1 + extra);
-
-  // where the foot is across: the tape band's ends, or the foot's side edges
-  foot.center_x = roi.x + (roi.width - 1) / 2.0;
-  foot.width = 0.75 * roi.width;
-  double band_top_row = -1, band_bottom_row = -1;
-  if (options.tape_colour) {
-    double left = 0, right = 0;
-    int top = 0, bottom = 0;
-    const cv::Rect region = cv::Rect(x0, roi.y, x1 - x0 + 1, roi.height) & image;
-    if (TapeBand(bgr, region, *options.tape_colour, left, right, top, bottom)) {
-      foot.center_x = 0.5 * (left + right);
-      foot.width = right - left;
-      foot.by_tape = true;
-      band_top_row = top;
-      band_bottom_row = bottom;
-    } else {
-      warnings.push_back("tape colour of foot " + std::string(FootName(*options.tape_colour)) +
-                         " (" + std::string(FootTapeColour(*options.tape_colour)) +
-                         ") not found in the foot region: located by brightness edges");
-    }
-  }
-  double left = 0, right = 0, polarity = 1;
-  bool sides = false;
-  if (foot.by_tape) {
-    sides = SideEdges(bgr, Round(band_top_row), Round(band_bottom_row), x0, x1, foot.center_x, left,
-                      right, polarity);
-  } else {
-    sides = SideEdges(bgr, roi.y + roi.height / 2, roi_bottom - Round(0.15 * roi.width), x0, x1,
-                      foot.center_x, left, right, polarity);
-    if (sides) {
-      foot.center_x = 0.5 * (left + right);
-      foot.width = right - left;
-    }
-  }
-  foot.polarity = sides ? polarity : 1.0;
-
-  // the bottom edge: the first strong foot-to-ground edge near the region's bottom (below
-  // the tape band when there is one)
-  int lo = roi_bottom - Round(0.3 * foot.width) - 2, hi = roi_bottom + 3;
-  if (foot.by_tape) {
-    const double band = band_bottom_row - band_top_row + 1;
-    lo = Round(band_bottom_row + 0.3 * band);
-    hi = std::max(hi, Round(band_bottom_row + 1.7 * band) + 2);
-  }
-  Edge bottom =
-      BottomEdge(bgr, foot.center_x, kColumnsHalfFraction * foot.width, lo, hi, foot.polarity);
-  if (!bottom.found) {
-    warnings.push_back("the foot's bottom edge is unclear: the foot region's bottom is used");
-    bottom.position = roi_bottom + 0.5 - 0.1 * foot.width;
-  }
-  foot.bottom = bottom.position;
-
-  // the width again, from the brightness edges on rows where the foot is at its widest (the
-  // tape's colour edges are blurred by chroma subsampling); with the tape, only when they
-  // agree with the tape's ends
-  {
-    const double w = foot.width;
-    if (SideEdges(bgr, Round(foot.bottom - 0.55 * w), Round(foot.bottom - 0.3 * w), x0, x1,
-                  foot.center_x, left, right, polarity) &&
-        (!foot.by_tape || std::abs(right - left - w) < 0.25 * w)) {
-      foot.center_x = 0.5 * (left + right);
-      foot.width = right - left;
-    } else if (!sides && !foot.by_tape) {
-      warnings.push_back(
-          "the foot's side edges are unclear: its width is taken as 75 % of the "
-          "foot region's");
-    }
-  }
-
-  // the template: the foot's central columns from one foot width above its bottom edge to
-  // just above it
-  columns_half = std::max(1.0, kColumnsHalfFraction * foot.width);
-  const int first_row = std::max({roi.y, 0, Round(foot.bottom - foot.width)});
-  const int last_row = std::min(Floor(foot.bottom - kTemplateBottomMarginPx), bgr.rows - 1);
-  const AxisWindow columns =
-      ClampWindow(MakeWindow(foot.center_x - columns_half, foot.center_x + columns_half), bgr.cols);
-  ColumnMean(bgr, columns, first_row, std::max(0, last_row - first_row + 1), 3, foot_template);
-  if (foot_template.length < 6) {
-    warnings.push_back("the foot's template is only " + Plural(foot_template.length, "row") +
-                       " tall: the foot region is too small or misplaced");
-  }
-
-  // the shake references
-  std::vector<cv::Rect> rects;
-  if (!options.reference_roi_px.empty()) {
-    rects.push_back(options.reference_roi_px);
-  } else {
-    rects = ChooseReferencePatches(bgr, foot, roi);
-    if (rects.empty()) {
-      warnings.push_back("no textured ground beside the foot: camera shake is not removed");
-    }
-  }
-  for (const cv::Rect& rect : rects) {
-    ReferencePatch patch;
-    patch.rect = rect;
-    ColumnMean(bgr, MakeWindow(rect.x - 0.5, rect.x + rect.width - 0.5), rect.y, rect.height, 1,
-               patch.vertical);
-    RowMean(bgr, MakeWindow(rect.y - 0.5, rect.y + rect.height - 0.5), rect.x, rect.width,
-            patch.horizontal);
-    patches.push_back(std::move(patch));
-  }
-  initialised = true;
-}
-
-// Registers one patch: its horizontal shift on the rows moved by the last vertical one,
-// then its vertical shift on the columns moved by the new horizontal one.
-bool FootTracker::Impl::MeasurePatch(const cv::Mat& bgr, ReferencePatch& patch, int radius,
-                                     bool& at_limit) {
-  const cv::Rect& rect = patch.rect;
-  const int cx = Round(patch.dx), cy = Round(patch.dy);
-  const int n_lo_x = std::max(cx - radius, -rect.x + 1);
-  const int n_hi_x = std::min(cx + radius, bgr.cols - rect.x - rect.width - 1);
-  const int n_lo_y = std::max(cy - radius, -rect.y + 1);
-  const int n_hi_y = std::min(cy + radius, bgr.rows - rect.y - rect.height - 1);
-  if (n_lo_x > n_hi_x || n_lo_y > n_hi_y) return false;
-
-  const AxisWindow rows = ClampWindow(
-      MakeWindow(rect.y - 0.5 + patch.dy, rect.y + rect.height - 0.5 + patch.dy), bgr.rows);
-  const int col_first = rect.x + n_lo_x - 1;
-  RowMean(bgr, rows, col_first, rect.width + n_hi_x - n_lo_x + 2, scratch);
-  const Match mx = Register(patch.horizontal, scratch, n_lo_x, n_hi_x, rect.width - radius);
-  if (!mx.found) return false;
-
-  const AxisWindow columns = ClampWindow(
-      MakeWindow(rect.x - 0.5 + mx.shift, rect.x + rect.width - 0.5 + mx.shift), bgr.cols);
-  const int row_first = rect.y + n_lo_y - 1;
-  ColumnMean(bgr, columns, row_first, rect.height + n_hi_y - n_lo_y + 2, 1, scratch);
-  const Match my = Register(patch.vertical, scratch, n_lo_y, n_hi_y, rect.height - radius);
-  if (!my.found) return false;
-  patch.dx = mx.shift;
-  patch.dy = my.shift;
-  patch.quality = std::min(mx.quality, my.quality);
-  at_limit = mx.at_limit || my.at_limit;
-  return true;
-}
-
-void FootTracker::Impl::MeasureShake(const cv::Mat& bgr) {
-  if (patches.empty()) return;
-  std::vector<double> xs, ys;
-  for (ReferencePatch& patch : patches) {
-    const double old_dx = patch.dx, old_dy = patch.dy;
-    bool at_limit = false;
-    bool ok = MeasurePatch(bgr, patch, kLocalSearchPx, at_limit);
-    if (!ok || at_limit || patch.quality < kRetryQuality) {
-      patch.dx = old_dx;
-      patch.dy = old_dy;
-      ok = MeasurePatch(bgr, patch, kMaxShakePx, at_limit);
-    }
-    if (ok && patch.quality >= 0.3) {
-      xs.push_back(patch.dx);
-      ys.push_back(patch.dy);
-    } else {
-      patch.dx = old_dx;
-      patch.dy = old_dy;
-    }
-  }
-  if (ys.empty()) return;  // keep the last shake
-  shake_x = MedianOf(xs);
-  shake_y = MedianOf(ys);
-}
-
-// The foot's vertical shift in the picture, searched first around where the last two
-// rises and the shake put it, then over every shift when that fails.
-HeightSample FootTracker::Impl::MeasureFoot(const cv::Mat& bgr) {
-  HeightSample sample;
-  sample.shake_y_px = shake_y;
-  if (foot_template.length < 3) {
-    sample.quality = 0;
-    return sample;
-  }
-  const AxisWindow columns = ClampWindow(
-      MakeWindow(foot.center_x - columns_half + shake_x, foot.center_x + columns_half + shake_x),
-      bgr.cols);
-  const int min_overlap = std::max(3, foot_template.length / 2);
-  const auto search = [&](int n_lo, int n_hi) {
-    const int first = std::max(0, foot_template.first + n_lo - 1);
-    const int last = std::min(bgr.rows - 1, foot_template.last() + n_hi + 1);
-    ColumnMean(bgr, columns, first, last - first + 1, 3, scratch);
-    return Register(foot_template, scratch, n_lo, n_hi, min_overlap);
+  const int margin_x = static_cast<int>(std::lround(kMarginFraction * roi.width));
+  const int margin_y = static_cast<int>(std::lround(kMarginFraction * roi.height));
+  work_px = cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
+                     roi.height + 2 * margin_y) &
+            cv::Rect(0, 0, size.width, size.height);
+  scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
+  const auto to_work = [&](int v, int origin) {
+    return static_cast<int>(std::lround((v - origin) * scale));
   };
-  const int predicted = Round(shake_y - (2 * last_rise - rise_before_last));
-  Match match = search(predicted - kLocalSearchPx, predicted + kLocalSearchPx);
-  if (!match.found || match.at_limit || match.quality < kRetryQuality) {
-    const Match wide = search(-(foot_template.last() - min_overlap + 1), kMaxShakePx);
-    if (wide.found && (!match.found || wide.quality > match.quality)) match = wide;
+  region_work_px = cv::Rect(cv::Point(to_work(roi.x, work_px.x), to_work(roi.y, work_px.y)),
+                            cv::Point(to_work(roi.x + roi.width, work_px.x),
+                                      to_work(roi.y + roi.height, work_px.y)));
+}
+
+void FootTracker::Impl::MakeWorkImage(const cv::Mat& bgr) {
+  cv::Mat crop = bgr(work_px), scaled;
+  if (scale < 1) {
+    cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+  } else {
+    scaled = crop;
   }
-  if (!match.found) {
-    sample.quality = 0;
-    sample.rise_px = last_rise;
-    return sample;
+  scaled.convertTo(work, CV_32FC3);
+}
+
+// Candidates on a grid, strongest vertical texture first, none overlapping another by more
+// than half; up to kRegionPatches inside the foot region and kMarginPatches around it.
+void FootTracker::Impl::InitialisePatches() {
+  struct Candidate {
+    PatchTemplate templ;
+    bool in_region;
+  };
+  std::vector<Candidate> candidates;
+  for (int y = 1; y + kPatchPx + 1 < work.rows; y += kPatchStridePx) {
+    for (int x = 1; x + kPatchPx + 1 < work.cols; x += kPatchStridePx) {
+      PatchTemplate templ = internal::MakePatchTemplate(work, cv::Point(x, y), kPatchPx);
+      if (!templ.usable || templ.texture_y < 1.0) continue;
+      const cv::Point centre(x + kPatchPx / 2, y + kPatchPx / 2);
+      candidates.push_back({std::move(templ), region_work_px.contains(centre)});
+    }
   }
-  sample.rise_px = shake_y - match.shift;
-  sample.quality = match.quality;
-  rise_before_last = last_rise;
-  last_rise = sample.rise_px;
-  return sample;
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.templ.texture_y > b.templ.texture_y;
+  });
+  size_t in_region = 0, in_margin = 0;
+  for (Candidate& candidate : candidates) {
+    size_t& count = candidate.in_region ? in_region : in_margin;
+    if (count >= (candidate.in_region ? kRegionPatches : kMarginPatches)) continue;
+    const bool overlaps = std::any_of(patches.begin(), patches.end(), [&](const TrackedPatch& p) {
+      return std::abs(p.templ.origin_px.x - candidate.templ.origin_px.x) < kPatchPx / 2.0 &&
+             std::abs(p.templ.origin_px.y - candidate.templ.origin_px.y) < kPatchPx / 2.0;
+    });
+    if (overlaps) continue;
+    TrackedPatch patch;
+    patch.position_px = candidate.templ.origin_px;
+    patch.in_region = candidate.in_region;
+    patch.templ = std::move(candidate.templ);
+    patches.push_back(std::move(patch));
+    ++count;
+  }
+}
+
+void FootTracker::Impl::MeasurePatches() {
+  for (TrackedPatch& patch : patches) {
+    float rise = kNaN;
+    if (!patch.lost) {
+      const PatchMatch match = internal::RegisterPatch(patch.templ, work, patch.position_px);
+      const double limit =
+          patch.typical_residual > 0 ? kResidualFactor * patch.typical_residual + kResidualFloor
+                                     : std::numeric_limits<double>::infinity();
+      const bool jumped = std::abs(match.origin_px.y - patch.position_px.y) > kPatchPx / 2.0 ||
+                          std::abs(match.origin_px.x - patch.position_px.x) > kPatchPx / 2.0;
+      if (match.ok && !jumped && match.residual_rms <= limit && std::abs(match.gain) < kMaxGain) {
+        patch.position_px = match.origin_px;
+        patch.typical_residual = patch.typical_residual > 0
+                                     ? 0.9 * patch.typical_residual + 0.1 * match.residual_rms
+                                     : match.residual_rms;
+        patch.misses = 0;
+        rise = static_cast<float>((patch.templ.origin_px.y - match.origin_px.y) / scale);
+      } else if (++patch.misses >= kLostFrames) {
+        patch.lost = true;
+      }
+    }
+    rises.push_back(rise);
+  }
 }
 
 FootTracker::FootTracker(const Options& options) : impl_(std::make_unique<Impl>()) {
@@ -934,18 +315,15 @@ Status FootTracker::Process(const Frame& frame) {
   }
   const cv::Rect image(0, 0, bgr.cols, bgr.rows);
   const std::string size_text = std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows);
-  if (!s.initialised) {
+  if (!s.size_known) {
     const cv::Rect& roi = s.options.foot_roi_px;
     if ((roi & image) != roi) {
       return InvalidArgumentError("foot ROI " + RectText(roi) + " is outside the " + size_text +
                                   " frame");
     }
-    const cv::Rect& reference = s.options.reference_roi_px;
-    if (!reference.empty() && (reference & image) != reference) {
-      return InvalidArgumentError("reference ROI " + RectText(reference) + " is outside the " +
-                                  size_text + " frame");
-    }
     s.frame_size = bgr.size();
+    s.size_known = true;
+    s.ChooseWorkRegion(s.frame_size);
   } else {
     if (bgr.size() != s.frame_size) {
       return InvalidArgumentError("frame " + std::to_string(frame.index) + " is " + size_text +
@@ -960,11 +338,28 @@ Status FootTracker::Process(const Frame& frame) {
     }
   }
   try {
-    if (!s.initialised) s.Initialise(bgr);
-    s.MeasureShake(bgr);
-    HeightSample sample = s.MeasureFoot(bgr);
+    s.MakeWorkImage(bgr);
+    if (!s.initialised) {
+      // the templates: the mean of the first frames (their noise would be in every sample)
+      if (s.accumulated.empty()) s.accumulated = cv::Mat::zeros(s.work.size(), CV_32FC3);
+      s.accumulated += s.work;
+      if (++s.accumulated_frames == kTemplateFrames) {
+        s.work = s.accumulated / kTemplateFrames;
+        s.InitialisePatches();
+        s.initialised = true;
+        s.accumulated.release();
+        s.MakeWorkImage(bgr);
+      }
+    }
+    if (s.initialised) {
+      s.MeasurePatches();
+    } else {
+      s.measured_from = s.samples.size() + 1;
+    }
+    HeightSample sample;
     sample.frame_index = frame.index;
     sample.t_ns = frame.t_ns;
+    sample.keyframe = frame.keyframe;
     s.samples.push_back(sample);
     s.last_t_ns = frame.t_ns;
   } catch (const cv::Exception& e) {
@@ -973,398 +368,569 @@ Status FootTracker::Process(const Frame& frame) {
   return Status::Ok();
 }
 
+// ---------------------------------------------------------------------------------------
+// finish: which patches are the foot and which the ground, the height curve, the liftoff
+
 namespace {
 
-// The hinge r0 + b * max(0, t - t0)^p, least squares for a given knee t0 and power p.
-struct Hinge {
-  double t0_s = 0, power = 1, level = 0, gain = 0;
-  double sse = std::numeric_limits<double>::infinity();
-  // First instant the hinge exceeds `height`, s (+inf when it never does).
-  double CrossingS(double height) const {
-    if (height <= level) return t0_s;
-    if (gain <= 0) return std::numeric_limits<double>::infinity();
-    return t0_s + std::pow((height - level) / gain, 1 / power);
+constexpr double kNaNd = std::numeric_limits<double>::quiet_NaN();
+
+// The patches' rises, frames x patches (rows before `measured_from` were not measured).
+class RiseTable {
+ public:
+  RiseTable(const std::vector<float>& rises, size_t patches, size_t measured_from)
+      : rises_(rises), patches_(patches), measured_from_(measured_from) {}
+  size_t patches() const { return patches_; }
+  size_t measured_from() const { return measured_from_; }
+  double Raw(size_t frame, size_t patch) const {
+    if (frame < measured_from_) return kNaNd;
+    const size_t at = (frame - measured_from_) * patches_ + patch;
+    return at < rises_.size() ? static_cast<double>(rises_[at]) : kNaNd;
   }
+
+ private:
+  const std::vector<float>& rises_;
+  size_t patches_, measured_from_;
 };
 
-Hinge FitHinge(const std::vector<double>& t_s, const std::vector<double>& y, double t0_s,
-               double power) {
-  Hinge hinge;
-  hinge.t0_s = t0_s;
-  hinge.power = power;
-  double sx = 0, sxx = 0, sy = 0, sxy = 0, syy = 0;
-  const double n = static_cast<double>(y.size());
-  for (size_t i = 0; i < y.size(); ++i) {
-    const double x = t_s[i] > t0_s ? std::pow(t_s[i] - t0_s, power) : 0.0;
-    sx += x;
-    sxx += x * x;
-    sy += y[i];
-    sxy += x * y[i];
-    syy += y[i] * y[i];
+// Per frame, the median over `members` of value(frame, patch); NaN where fewer than
+// `min_count` are finite.
+template <typename Value>
+std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
+                                size_t min_count, const Value& value) {
+  std::vector<double> curve(frames, kNaNd);
+  std::vector<double> values;
+  for (size_t f = 0; f < frames; ++f) {
+    values.clear();
+    for (size_t p : members) values.push_back(value(f, p));
+    const double median = FiniteMedian(values);
+    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = median;
   }
-  const double var_y = syy - sy * sy / n;
-  const double var_x = sxx - sx * sx / n;
-  const double cov = sxy - sx * sy / n;
-  if (var_x <= 0 || cov <= 0) {  // no rise: the flat line
-    hinge.level = sy / n;
-    hinge.sse = var_y;
-    return hinge;
+  return curve;
+}
+
+// Median of the last `count` finite values of value(f) over frames [first, frames).
+template <typename Value>
+double FinalLevel(size_t first, size_t frames, size_t count, const Value& value) {
+  std::vector<double> values;
+  for (size_t f = frames; f-- > first && values.size() < count;) {
+    const double v = value(f);
+    if (std::isfinite(v)) values.push_back(v);
   }
-  hinge.gain = cov / var_x;
-  hinge.level = (sy - hinge.gain * sx) / n;
-  hinge.sse = var_y - cov * cov / var_x;
-  return hinge;
+  return FiniteMedian(values);
+}
+
+// Running median over +-half frames (NaN stays NaN and is skipped).
+std::vector<double> RunningMedian(const std::vector<double>& curve, size_t half) {
+  std::vector<double> out(curve.size(), kNaNd);
+  std::vector<double> window;
+  for (size_t i = 0; i < curve.size(); ++i) {
+    if (!std::isfinite(curve[i])) continue;
+    window.assign(curve.begin() + static_cast<std::ptrdiff_t>(i >= half ? i - half : 0),
+                  curve.begin() + static_cast<std::ptrdiff_t>(std::min(curve.size(), i + half + 1)));
+    out[i] = FiniteMedian(window);
+  }
+  return out;
+}
+
+// 1.4826 x the median absolute deviation of the finite values; 0 for none.
+double RobustSpread(std::vector<double> values) {
+  const double median = FiniteMedian(values);
+  if (!std::isfinite(median)) return 0;
+  for (double& v : values) v = std::abs(v - median);
+  const double mad = FiniteMedian(values);
+  return std::isfinite(mad) ? 1.4826 * mad : 0.0;
+}
+
+// Frames of `samples` in `seconds` at the clip's median rate (at least 1).
+size_t FramesIn(const std::vector<HeightSample>& samples, double seconds) {
+  std::vector<double> intervals;
+  for (size_t i = 1; i < samples.size(); ++i) {
+    intervals.push_back(Seconds(samples[i].t_ns - samples[i - 1].t_ns));
+  }
+  const double interval = FiniteMedian(intervals);
+  if (!(interval > 0)) return 1;
+  return std::max<size_t>(1, static_cast<size_t>(std::lround(seconds / interval)));
+}
+
+// What the patches say.
+struct PatchSelection {
+  std::vector<size_t> foot, ground;
+  std::vector<double> height_px;  // per frame, up positive, rest 0; NaN where unmeasured
+  std::vector<double> shake_px;   // per frame, up positive
+  std::vector<double> quality;    // per frame: fraction of the foot's patches measured
+};
+
+// Rest levels, the ground (patches that end where they began: their median is the shake),
+// the foot (patches of the region that end highest, less those that do not move with
+// the others) and its height: the median of the foot's patches less the shake.
+PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPatch>& patches,
+                             const std::vector<size_t>& rest, size_t frames, size_t final_count) {
+  PatchSelection selection;
+  const size_t first = rest.front();
+  std::vector<double> rest_level(table.patches(), kNaNd);
+  for (size_t p = 0; p < table.patches(); ++p) {
+    std::vector<double> values;
+    for (size_t f : rest) values.push_back(table.Raw(f, p));
+    const double level = FiniteMedian(values);
+    if (values.size() * 2 >= rest.size()) rest_level[p] = level;
+  }
+  const auto from_rest = [&](size_t f, size_t p) { return table.Raw(f, p) - rest_level[p]; };
+  std::vector<size_t> margin, region;
+  for (size_t p = 0; p < table.patches(); ++p) {
+    if (std::isfinite(rest_level[p])) (patches[p].in_region ? region : margin).push_back(p);
+  }
+  const auto finite_or_zero = [](double v) { return std::isfinite(v) ? v : 0.0; };
+
+  // ground and shake: a first shake from the margin, then the patches that end at rest
+  const std::vector<double> margin_shake = MedianCurve(frames, margin, 1, from_rest);
+  for (size_t p = 0; p < table.patches(); ++p) {
+    if (!std::isfinite(rest_level[p])) continue;
+    const double final_rise = FinalLevel(first, frames, final_count, [&](size_t f) {
+      return from_rest(f, p) - finite_or_zero(margin_shake[f]);
+    });
+    if (std::abs(final_rise) <= kGroundTolerancePx) selection.ground.push_back(p);
+  }
+  selection.shake_px = MedianCurve(frames, selection.ground, 1, from_rest);
+  for (double& v : selection.shake_px) v = finite_or_zero(v);
+  const auto relative = [&](size_t f, size_t p) { return from_rest(f, p) - selection.shake_px[f]; };
+
+  // the foot: the region's patches that end highest ...
+  std::vector<std::pair<double, size_t>> finals;
+  for (size_t p : region) {
+    const double final_rise =
+        FinalLevel(first, frames, final_count, [&](size_t f) { return relative(f, p); });
+    if (std::isfinite(final_rise)) finals.emplace_back(final_rise, p);
+  }
+  std::sort(finals.rbegin(), finals.rend());
+  if (finals.empty()) return selection;
+  const double top = finals[std::min<size_t>(1, finals.size() - 1)].first;
+  std::vector<size_t> candidates;
+  for (const auto& [final_rise, p] : finals) {
+    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx) candidates.push_back(p);
+  }
+  // ... and move with the others
+  const std::vector<double> common = MedianCurve(frames, candidates, 1, relative);
+  std::vector<double> deviations(candidates.size());
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    std::vector<double> values;
+    for (size_t f = first; f < frames; ++f) values.push_back(std::abs(relative(f, candidates[i]) - common[f]));
+    deviations[i] = FiniteMedian(values);
+  }
+  std::vector<double> sorted = deviations;
+  const double typical = FiniteMedian(sorted);
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (deviations[i] <= 3 * typical + kCoherencePx) selection.foot.push_back(candidates[i]);
+  }
+  const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
+  selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
+  selection.quality.assign(frames, 0.0);
+  for (size_t f = 0; f < frames; ++f) {
+    size_t measured = 0;
+    for (size_t p : selection.foot) measured += std::isfinite(table.Raw(f, p)) ? 1u : 0u;
+    if (!selection.foot.empty()) {
+      selection.quality[f] =
+          static_cast<double>(measured) / static_cast<double>(selection.foot.size());
+    }
+  }
+  return selection;
+}
+
+// The liftoff in the height curve: where the curve rises for good, the stretch of rest
+// before it, and the model fitted over both.
+struct LiftoffSearch {
+  internal::RiseFit fit;
+  double lag_bound_px = 0;             // a codec's lag allowed for, px (0: none)
+  size_t fit_first = 0, fit_last = 0;  // frames fitted
+  double max_rise_px = 0;              // of the smoothed curve
+  std::string not_found;               // why there is no liftoff, when there is none
+};
+
+// A key frame among frames (f - half, f + half + 1], the latest; 0 for none.
+size_t KeyframeNear(const std::vector<HeightSample>& samples, size_t f, size_t half) {
+  const size_t last = std::min(samples.size() - 1, f + half + 1);
+  for (size_t g = last; g > f - std::min(f, half) && g > 0; --g) {
+    if (samples[g].keyframe) return g;
+  }
+  return 0;
+}
+
+// The curve's step at frame `key`: the median of `count` frames from it less that of the
+// `count` before it.
+double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
+  std::vector<double> after, before;
+  for (size_t g = key; g < std::min(curve.size(), key + count); ++g) after.push_back(curve[g]);
+  for (size_t g = key - std::min(key, count); g < key; ++g) before.push_back(curve[g]);
+  const double step = FiniteMedian(after) - FiniteMedian(before);
+  return std::isfinite(step) ? step : 0.0;
+}
+
+// How far a codec may have held the foot back, px: its largest catch-up in one frame over
+// frames [first, last] beyond the typical frame-to-frame change (at least kMinLagPx).
+double LagBoundPx(const std::vector<double>& height, size_t first, size_t last) {
+  std::vector<double> changes;
+  double largest = 0;
+  for (size_t f = first + 1; f <= last; ++f) {
+    if (!std::isfinite(height[f]) || !std::isfinite(height[f - 1])) continue;
+    const double change = height[f] - height[f - 1];
+    changes.push_back(std::abs(change));
+    largest = std::max(largest, change);
+  }
+  const double typical = FiniteMedian(changes);
+  return std::max(kMinLagPx, kLagBoundFactor * (largest - (std::isfinite(typical) ? typical : 0.0)));
+}
+
+LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
+                          const std::vector<double>& height, size_t first, double threshold_px,
+                          double rest_noise_px, bool lossy) {
+  LiftoffSearch search;
+  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
+  for (size_t f = first; f < smooth.size(); ++f) {
+    if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
+  }
+  // the rise for good: the first frame from which the smoothed curve stays above the
+  // threshold for kSustainS (or to the clip's end, if that is at least kSustainFrames frames
+  // and two thresholds up); the cut: where it then reaches the fit's top
+  const size_t sustain = std::max<size_t>(kSustainFrames, FramesIn(samples, kSustainS));
+  size_t rise = smooth.size();
+  for (size_t f = first; f < smooth.size() && rise == smooth.size(); ++f) {
+    if (!(smooth[f] >= threshold_px)) continue;
+    size_t above = 0, g = f;
+    double highest = smooth[f];
+    for (; g < smooth.size() && above < sustain; ++g) {
+      if (!std::isfinite(smooth[g])) continue;
+      if (smooth[g] < threshold_px) break;
+      highest = std::max(highest, smooth[g]);
+      ++above;
+    }
+    const bool to_the_end = g == smooth.size() && above >= kSustainFrames &&
+                            highest >= 2 * threshold_px;
+    if (above >= sustain || to_the_end) rise = f;
+  }
+  size_t cut = smooth.size();
+  if (rise < smooth.size()) {
+    double highest = 0;
+    for (size_t f = rise; f < smooth.size(); ++f) {
+      if (std::isfinite(smooth[f])) highest = std::max(highest, smooth[f]);
+    }
+    const double top = std::min(std::max(kFitTopThresholds * threshold_px, kFitTopPx), 0.8 * highest);
+    for (size_t f = rise; f < smooth.size() && cut == smooth.size(); ++f) {
+      if (smooth[f] >= top) cut = f;
+    }
+  }
+  if (cut == smooth.size()) {
+    search.not_found = "the foot never lifts: its largest rise is " +
+                       FormatFixed(search.max_rise_px, 2) + " px above rest, below the " +
+                       FormatFixed(threshold_px, 2) + " px threshold held for " +
+                       FormatFixed(kSustainS, 1) + " s";
+    return search;
+  }
+  size_t cut_with_key = 0;
+  // a key frame soon after the cut shows the foot without lag: fit up to it
+  for (size_t f = cut + 1; f < smooth.size(); ++f) {
+    if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
+    if (lossy && samples[f].keyframe && std::isfinite(height[f])) {
+      cut_with_key = f;
+      break;
+    }
+  }
+  // back from the cut: the climb, then up to kFitRestS of rest (a step in it ends the rest,
+  // but for a key frame's: a codec's new picture quality, not a motion, so the frames
+  // before it are levelled with those after)
+  const double tolerance = std::max(3 * rest_noise_px, 0.3 * threshold_px);
+  const size_t half = FramesIn(samples, kSmoothHalfS);
+  std::vector<double> levelled = height, levelled_smooth = smooth;
+  size_t flat_since = cut, start = cut;
+  double anchor = smooth[cut];
+  bool resting = false;
+  size_t levelled_at = 0;  // the last key frame levelled at (its smoothed neighbours are mixed)
+  for (size_t f = cut; f-- > first;) {
+    if (!std::isfinite(levelled_smooth[f])) continue;
+    if (levelled_at > 0 && f + half >= levelled_at) {
+      start = f;
+      continue;
+    }
+    // at rest, a wander within the threshold is noise for the robust fit, not a step
+    const double allowed = resting ? std::max(tolerance, threshold_px) : tolerance;
+    const bool below = levelled_smooth[f] < anchor - allowed;
+    const bool above = levelled_smooth[f] > anchor + allowed;
+    if ((below && resting) || above) {
+      const size_t key = lossy && resting ? KeyframeNear(samples, f, half) : 0;
+      if (key == 0) break;
+      const double step = LevelStep(levelled, key, 2 * half + 1);
+      for (size_t g = first; g < key; ++g) {
+        levelled[g] += step;
+        levelled_smooth[g] += step;
+      }
+      levelled_at = key;
+      start = f;
+      continue;
+    } else if (below) {
+      anchor = levelled_smooth[f];
+      flat_since = f;
+    }
+    start = f;
+    const double flat_s = Seconds(samples[flat_since].t_ns - samples[f].t_ns);
+    if (flat_s >= kRestingS) resting = true;
+    if (flat_s >= kFitRestS) break;
+  }
+  // the model over the stretch (raw heights: the fit is robust to single frames)
+  // a lossy codec may hold slow motion back: a predicted frame until the picture is renewed,
+  // an intra-only codec (MJPEG) by quantising an edge's sub-pixel position; a key frame
+  // among predicted ones renews the picture
+  const bool predicted = std::any_of(samples.begin(), samples.end(),
+                                     [](const HeightSample& sample) { return !sample.keyframe; });
+  std::vector<double> t_s, h;
+  std::vector<bool> lag_free;
+  for (size_t f = start; f <= std::max(cut, cut_with_key); ++f) {
+    if (!std::isfinite(levelled[f])) continue;
+    t_s.push_back(Seconds(samples[f].t_ns - samples[start].t_ns));
+    h.push_back(levelled[f]);
+    lag_free.push_back(!lossy || (predicted && samples[f].keyframe));
+  }
+  internal::RiseFitOptions fit_options;
+  fit_options.threshold = threshold_px;
+  const bool may_lag = std::find(lag_free.begin(), lag_free.end(), false) != lag_free.end();
+  if (may_lag) {
+    fit_options.lag_bound = LagBoundPx(height, start, std::max(cut, cut_with_key));
+    fit_options.lag_weight = kLagWeight;
+  }
+  search.lag_bound_px = fit_options.lag_bound;
+  search.fit = internal::FitRise(t_s, h, lag_free, fit_options);
+  const double origin_s = Seconds(samples[start].t_ns);
+  if (search.fit.ok) {
+    for (double* t : {&search.fit.knee_s, &search.fit.knee_low_s, &search.fit.knee_high_s,
+                      &search.fit.crossing_s, &search.fit.crossing_low_s,
+                      &search.fit.crossing_high_s}) {
+      *t += origin_s;
+    }
+  } else {
+    search.not_found = "the foot's rise could not be fitted between " +
+                       FormatSeconds(samples[start].t_ns, 3) + " and " +
+                       FormatSeconds(samples[cut].t_ns, 3) + " s";
+  }
+  if (search.fit.ok) search.fit.crossing_middle_s += origin_s;
+  search.fit_first = start;
+  search.fit_last = std::max(cut, cut_with_key);
+  return search;
+}
+
+// The frames either side of t_ns and the instant with its uncertainty.
+TimedEvent MakeEvent(const std::vector<HeightSample>& samples, double t_s, double uncertainty_s) {
+  TimedEvent event;
+  event.t_ns = RoundNs(t_s * 1e9);
+  event.uncertainty_ns = RoundNs(uncertainty_s * 1e9);
+  size_t after = 0;
+  while (after < samples.size() && samples[after].t_ns < event.t_ns) ++after;
+  after = std::min(after, samples.size() - 1);
+  event.frame_after = samples[after].frame_index;
+  event.frame_before = samples[after > 0 ? after - 1 : 0].frame_index;
+  return event;
 }
 
 }  // namespace
 
-Result<FootTrack> FootTracker::Finish() const& {
-  Result<FootTrack> track = FinishWithoutSamples();
-  if (track.ok()) track->samples = impl_->samples;
-  return track;
+namespace {
+
+std::string PatchCount(size_t count) {
+  return std::to_string(count) + (count == 1 ? " patch" : " patches");
 }
 
-Result<FootTrack> FootTracker::Finish() && {
-  Result<FootTrack> track = FinishWithoutSamples();
-  if (track.ok()) track->samples = std::move(impl_->samples);
-  return track;
+// The nominal tape colours of the synthetic scenes, BGR (A blue, B orange, C purple, D red).
+cv::Vec3d NominalTapeBgr(Foot foot) {
+  switch (foot) {
+    case Foot::kA: return {200, 80, 20};
+    case Foot::kB: return {20, 140, 255};
+    case Foot::kC: return {160, 40, 130};
+    case Foot::kD: return {30, 30, 210};
+  }
+  return {128, 128, 128};
 }
 
-Result<FootTrack> FootTracker::FinishWithoutSamples() const {
+// Warnings where the evidence is weak; low_confidence when any is.
+void AddConfidenceWarnings(FootTrack& track, const PatchSelection& selection,
+                           const internal::RiseFit& fit, double uncertainty_s) {
+  std::vector<std::string> weak;
+  if (selection.foot.size() < kFewFootPatches) {
+    weak.push_back("only " + PatchCount(selection.foot.size()) +
+                   " moved with the foot");
+  }
+  if (fit.noise > kNoisyFraction * track.threshold_px) {
+    weak.push_back("the height curve is noisy (" + FormatFixed(fit.noise, 2) +
+                   " px rms against a " + FormatFixed(track.threshold_px, 2) + " px threshold)");
+  }
+  if (uncertainty_s > kWideUncertaintyS) {
+    weak.push_back("the instant is uncertain by +- " + FormatFixed(uncertainty_s * 1e3, 0) + " ms");
+  }
+  if (track.max_rise_px < kShortRiseThresholds * track.threshold_px) {
+    weak.push_back("the clip ends " + FormatFixed(track.max_rise_px / track.threshold_px, 1) +
+                   " thresholds up");
+  }
+  for (const std::string& reason : weak) {
+    track.warnings.push_back("foot: low confidence: " + reason);
+  }
+  track.low_confidence = !weak.empty();
+  if (selection.ground.size() < kFewGroundPatches) {
+    track.warnings.push_back("foot: only " +
+                             PatchCount(selection.ground.size()) +
+                             " of static ground around the foot: camera shake is removed poorly");
+  }
+}
+
+// Whether the mean colour of the foot's patches leans towards the tape's hue.
+bool ShowsTapeColour(const std::vector<TrackedPatch>& patches, const std::vector<size_t>& foot,
+                     Foot tape) {
+  cv::Vec3d sum(0, 0, 0);
+  double count = 0;
+  for (size_t p : foot) {
+    const std::vector<float>& values = patches[p].templ.values;
+    for (size_t i = 0; i + 2 < values.size(); i += 3) {
+      sum += cv::Vec3d(values[i], values[i + 1], values[i + 2]);
+      ++count;
+    }
+  }
+  if (count == 0) return false;
+  const cv::Vec3d mean = sum / count;
+  const cv::Vec3d nominal = NominalTapeBgr(tape);
+  const auto chroma = [](const cv::Vec3d& bgr) {
+    const double grey = (bgr[0] + bgr[1] + bgr[2]) / 3;
+    return bgr - cv::Vec3d(grey, grey, grey);
+  };
+  const cv::Vec3d a = chroma(mean), b = chroma(nominal);
+  const double norms = cv::norm(a) * cv::norm(b);
+  return norms > 0 && a.dot(b) / norms > 0.5;
+}
+
+}  // namespace
+
+Result<FootTrack> FootTracker::Finish() const& { return FinishWith(impl_->samples); }
+
+Result<FootTrack> FootTracker::Finish() && { return FinishWith(std::move(impl_->samples)); }
+
+Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) const {
   const Impl& s = *impl_;
-  if (!s.options_status.ok()) return s.options_status;
-  if (s.samples.empty()) return InvalidArgumentError("no frame was given to the foot tracker");
   const Options& o = s.options;
-  const std::vector<HeightSample>& samples = s.samples;
+  if (!s.options_status.ok()) return s.options_status;
+  if (samples.empty()) return InvalidArgumentError("no frame was given to the foot tracker");
+  if (!s.initialised || s.patches.empty()) {
+    return NotFoundError("the foot region " + RectText(o.foot_roi_px) +
+                         " shows nothing to track (too few frames, or no edge or texture)");
+  }
+  const size_t frames = samples.size();
+  const RiseTable table(s.rises, s.patches.size(), s.measured_from);
+
+  // the rest window's frames
+  std::vector<size_t> rest;
+  for (size_t f = s.measured_from; f < frames; ++f) {
+    const int64_t t = samples[f].t_ns;
+    const bool inside = s.rest_to_ns > s.rest_from_ns
+                            ? (t >= s.rest_from_ns && t < s.rest_to_ns)
+                            : f < s.measured_from + static_cast<size_t>(o.rest_frames);
+    if (inside) rest.push_back(f);
+  }
+  if (rest.empty()) {
+    return InvalidArgumentError("the rest window " + FormatSeconds(s.rest_from_ns, 4) + " .. " +
+                                FormatSeconds(s.rest_to_ns, 4) +
+                                " s holds no frame the foot tracker measured");
+  }
+  const PatchSelection selection =
+      SelectPatches(table, s.patches, rest, frames, std::max<size_t>(5, FramesIn(samples, 0.5)));
 
   FootTrack track;
   track.foot_roi_px = o.foot_roi_px;
-  for (const ReferencePatch& patch : s.patches) {
-    track.reference_patches_px.push_back(patch.rect);
-    track.reference_roi_px =
-        track.reference_roi_px.empty() ? patch.rect : (track.reference_roi_px | patch.rect);
+  track.exposure_offset_ns = 0;  // a frame's time is the middle of its exposure
+  const auto frame_rect = [&](const PatchTemplate& templ) {
+    return cv::Rect(static_cast<int>(std::lround(s.work_px.x + templ.origin_px.x / s.scale)),
+                    static_cast<int>(std::lround(s.work_px.y + templ.origin_px.y / s.scale)),
+                    static_cast<int>(std::lround(kPatchPx / s.scale)),
+                    static_cast<int>(std::lround(kPatchPx / s.scale)));
+  };
+  for (size_t p : selection.ground) {
+    track.reference_patches_px.push_back(frame_rect(s.patches[p].templ));
+    track.reference_roi_px |= track.reference_patches_px.back();
   }
-  track.foot_center_x_px = s.foot.center_x;
-  track.foot_width_px = s.foot.width;
-  track.foot_bottom_px = s.foot.bottom;
-  track.template_first_row = s.foot_template.first;
-  track.template_last_row = s.foot_template.last();
-  track.located_by_tape = s.foot.by_tape;
-  track.warnings = s.warnings;
-  // a "foot" nearly as wide as its region is most likely the region's own edges
-  std::string region_warning;
-  if (s.foot.width > kWideFootFraction * o.foot_roi_px.width) {
-    region_warning = "the located foot is " + FormatFixed(s.foot.width, 0) + " px wide, " +
-                     FormatFixed(100 * s.foot.width / o.foot_roi_px.width, 0) +
-                     " % of the foot region's width: the region is probably far too large "
-                     "(give one around the foot only)";
-    track.warnings.push_back(region_warning);
+  cv::Rect foot_box;
+  for (size_t p : selection.foot) {
+    track.foot_patches_px.push_back(frame_rect(s.patches[p].templ));
+    foot_box |= track.foot_patches_px.back();
   }
+  if (selection.foot.empty()) {
+    return NotFoundError("the foot never lifts: nothing in the foot region " +
+                         RectText(o.foot_roi_px) + " rises against the ground around it");
+  }
+  track.foot_center_x_px = foot_box.x + (foot_box.width - 1) / 2.0;
+  track.foot_width_px = foot_box.width;
+  track.foot_bottom_px = foot_box.y + foot_box.height - 0.5;
 
-  // frame interval and the mid-exposure offset
-  std::vector<double> steps;
-  for (size_t i = 1; i < samples.size(); ++i) {
-    steps.push_back(static_cast<double>(samples[i].t_ns - samples[i - 1].t_ns));
-  }
-  const double interval_ns = steps.empty() ? 1e9 / 30 : MedianOf(std::move(steps));
-  double offset_ns = 0, offset_uncertainty_ns = 0;
-  if (o.exposure_s > 0) {
-    offset_ns = 0.5 * o.exposure_s * 1e9;
-  } else {
-    offset_ns = 0.25 * interval_ns;
-    offset_uncertainty_ns = 0.25 * interval_ns;
-  }
-  track.exposure_offset_ns = RoundNs(offset_ns);
-
-  const auto good = [&](size_t i) { return samples[i].quality >= o.min_quality; };
-  for (size_t i = 0; i < samples.size(); ++i) {
-    if (!good(i)) ++track.poor_frames;
-  }
-  if (track.poor_frames > 0) {
-    track.warnings.push_back(Plural(track.poor_frames, "frame") +
-                             " with a poor match of the foot (quality < " +
-                             FormatFixed(o.min_quality, 2) + ") left out");
-  }
-
-  // the rest window
-  std::vector<size_t> rest;
-  size_t rest_start = 0;
-  if (s.rest_to_ns > s.rest_from_ns) {
-    rest_start = samples.size();
-    for (size_t i = 0; i < samples.size(); ++i) {
-      if (samples[i].t_ns < s.rest_from_ns) continue;
-      rest_start = std::min(rest_start, i);
-      if (samples[i].t_ns < s.rest_to_ns && good(i)) rest.push_back(i);
-    }
-    if (rest.empty()) {
-      return InvalidArgumentError("the rest window " + FormatSeconds(s.rest_from_ns, 4) + " .. " +
-                                  FormatSeconds(s.rest_to_ns, 4) +
-                                  " s holds no frame with a clear view of the foot");
-    }
-  } else {
-    for (size_t i = 0; i < samples.size() && rest.size() < static_cast<size_t>(o.rest_frames);
-         ++i) {
-      if (good(i)) rest.push_back(i);
-    }
-    if (rest.empty()) return NotFoundError("no frame shows the foot clearly");
-  }
-  double sum = 0, sum2 = 0;
-  for (size_t i : rest) sum += samples[i].rise_px;
-  track.rest_rise_px = sum / static_cast<double>(rest.size());
-  for (size_t i : rest) sum2 += std::pow(samples[i].rise_px - track.rest_rise_px, 2);
-  track.rest_noise_px =
-      rest.size() > 1 ? std::sqrt(sum2 / static_cast<double>(rest.size() - 1)) : 0.0;
-  if (rest.size() < 3) {
-    track.warnings.push_back("the rest window holds only " +
-                             Plural(static_cast<int64_t>(rest.size()), "frame") +
-                             ": the rest level is uncertain");
-  }
-  // noise floor: sub-pixel registration is not better than ~0.01 px, whatever the frames say
-  const double noise_px = std::max(track.rest_noise_px, 0.01);
-  const double rest_error_px = noise_px / std::sqrt(static_cast<double>(rest.size()));
-
-  // the threshold
+  // the scale and the threshold
   if (o.threshold_px > 0) {
     track.threshold_px = o.threshold_px;
     track.px_per_mm = o.px_per_mm;
   } else {
-    if (o.px_per_mm > 0) {
-      track.px_per_mm = o.px_per_mm;
-    } else {
-      track.px_per_mm = s.foot.width / o.foot_width_mm;
-      track.px_per_mm_estimated = true;
-    }
+    track.px_per_mm = o.px_per_mm > 0 ? o.px_per_mm : foot_box.width / o.foot_width_mm;
+    track.px_per_mm_estimated = !(o.px_per_mm > 0);
     track.threshold_px = o.threshold_mm * track.px_per_mm;
-  }
-  const double threshold = track.threshold_px;
-  const auto excess = [&](size_t i) { return samples[i].rise_px - track.rest_rise_px; };
-
-  // the first sustained crossing
-  std::vector<size_t> valid;  // good samples from the rest window's start
-  for (size_t i = rest_start; i < samples.size(); ++i) {
-    if (good(i)) valid.push_back(i);
-  }
-  track.max_rise_px = 0;
-  for (size_t i : valid) track.max_rise_px = std::max(track.max_rise_px, excess(i));
-  std::optional<size_t> crossing;  // position in `valid`
-  for (size_t k = 0; k < valid.size(); ++k) {
-    if (excess(valid[k]) <= threshold) continue;
-    // sustained: the next frames (as many as the clip still has) stay above
-    const size_t need = std::min(static_cast<size_t>(o.confirm_frames), valid.size() - k);
-    size_t above = 0;
-    while (above < need && excess(valid[k + above]) > threshold) ++above;
-    if (above == need) {
-      crossing = k;
-      break;
-    }
-  }
-  const std::string threshold_text =
-      FormatFixed(threshold, 2) + " px" +
-      (track.px_per_mm > 0 && o.threshold_px == 0
-           ? " (" + FormatFixed(o.threshold_mm, 2) + " mm" +
-                 (track.px_per_mm_estimated ? ", scale estimated" : "") + ")"
-           : "");
-  if (!crossing) {
-    return NotFoundError("the foot never lifts: its largest rise is " +
-                         FormatFixed(track.max_rise_px, 2) + " px above rest, below the " +
-                         threshold_text + " threshold" +
-                         (region_warning.empty() ? std::string() : "; " + region_warning));
-  }
-  const size_t k = *crossing;
-  const auto t_of = [&](size_t i) {  // mid-exposure, ns
-    return static_cast<double>(samples[i].t_ns) + offset_ns;
-  };
-  if (samples[valid[k]].t_ns < s.rest_to_ns) {
-    track.warnings.push_back(
-        "the foot rose above the threshold inside the rest window: the rest "
-        "level is suspect");
-  }
-
-  // the local estimate: a line through the two frames either side of the crossing
-  const size_t after = valid[k];
-  const size_t before = k > 0 ? valid[k - 1] : after;
-  const double origin = t_of(after);
-  const double t_before = t_of(before) - origin;                  // ns, <= 0
-  double local_ns = 0, local_spread_ns = interval_ns, slope = 0;  // slope: px per ns
-  if (k == 0) {
-    track.warnings.push_back("the foot was already above the threshold at the start");
-  } else {
-    double st = 0, sy = 0, stt = 0, sty = 0, n = 0;
-    for (size_t j = (k >= 2 ? k - 2 : 0); j < std::min(valid.size(), k + 2); ++j) {
-      const double t = t_of(valid[j]) - origin;
-      st += t;
-      sy += excess(valid[j]);
-      stt += t * t;
-      sty += t * excess(valid[j]);
-      n += 1;
-    }
-    const double mean_t = st / n;
-    const double var_t = stt - st * st / n;
-    slope = var_t > 0 ? (sty - st * sy / n) / var_t : 0;
-    if (slope > 0) {
-      local_ns = std::clamp((threshold - (sy / n - slope * mean_t)) / slope, t_before, 0.0);
-    } else {  // a line between the two bracketing frames
-      const double e0 = excess(before), e1 = excess(after);
-      slope = (e1 - e0) / -t_before;
-      local_ns = t_before + (threshold - e0) / (e1 - e0) * -t_before;
-    }
-    // the line's standard error and the rest level's, over the slope (two deviations)
-    const double line_error_px =
-        noise_px *
-        std::sqrt(1 / n + (var_t > 0 ? (local_ns - mean_t) * (local_ns - mean_t) / var_t : 0));
-    local_spread_ns = std::min(2 * std::hypot(line_error_px, rest_error_px) / slope, -t_before);
-  }
-
-  // the hinge: flat, then rising as a power of the time since the knee, fitted from the rest
-  // window (at most 6 s before the crossing) to where the foot is 5 thresholds up (at least
-  // 6 frames past the crossing, at most 2 s); its knee is the onset and it smooths the
-  // crossing over compression's stepwise updates of a slowly moving picture
-  size_t end = k;
-  while (end + 1 < valid.size() &&
-         (end < k + 6 || excess(valid[end]) < kFitEndThresholds * threshold) &&
-         t_of(valid[end + 1]) - origin <= 2e9) {
-    ++end;
-  }
-  size_t begin = k;
-  while (begin > 0 && origin - t_of(valid[begin - 1]) <= 6e9) --begin;
-  std::vector<double> fit_t, fit_y;
-  for (size_t j = begin; j <= end; ++j) {
-    fit_t.push_back((t_of(valid[j]) - origin) / 1e9);
-    fit_y.push_back(excess(valid[j]));
-  }
-  const std::array<double, 7> powers = {1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0};
-  std::vector<Hinge> hinges;
-  Hinge best;
-  const auto evaluate = [&](double t0_s) {
-    for (double power : powers) {
-      const Hinge hinge = FitHinge(fit_t, fit_y, t0_s, power);
-      if (hinge.gain <= 0) continue;
-      hinges.push_back(hinge);
-      if (hinge.sse < best.sse) best = hinge;
-    }
-  };
-  // coarse: every frame up to the crossing (at most 3 s before it); fine: a tenth of a
-  // frame around the best
-  for (size_t j = 0; j <= k - begin; ++j) {
-    if (fit_t[j] >= -3.0) evaluate(fit_t[j]);
-  }
-  const double step_s = interval_ns / 1e9 / 10;
-  if (std::isfinite(best.sse)) {
-    const double coarse_best = best.t0_s;
-    for (int i = -20; i <= 20; ++i) {
-      const double t0 = coarse_best + i * step_s;
-      if (t0 >= fit_t.front() && t0 <= 0) evaluate(t0);
+    if (track.px_per_mm_estimated) {
+      track.warnings.push_back("foot: scale estimated from the tracked foot's width (" +
+                               FormatFixed(foot_box.width, 0) + " px taken as " +
+                               FormatFixed(o.foot_width_mm, 0) +
+                               " mm); give px_per_mm for a known scale");
     }
   }
 
-  // how far the curve strays from the hinge near the crossing (noise, or a codec's lag)
-  double wobble_px = 0;
-  if (std::isfinite(best.sse)) {
-    double sum_sq = 0, count = 0;
-    for (size_t j = 0; j < fit_t.size(); ++j) {
-      if (std::abs(fit_t[j]) > 6 * interval_ns / 1e9) continue;
-      const double x = fit_t[j] > best.t0_s ? std::pow(fit_t[j] - best.t0_s, best.power) : 0.0;
-      sum_sq += std::pow(fit_y[j] - best.level - best.gain * x, 2);
-      count += 1;
-    }
-    wobble_px = count > 0 ? std::sqrt(sum_sq / count) : 0;
+  // the samples and the rest
+  std::vector<double> rest_heights;
+  double held = 0;
+  for (size_t f = 0; f < frames; ++f) {
+    HeightSample& sample = samples[f];
+    const double h = selection.height_px[f];
+    if (std::isfinite(h)) held = h;
+    sample.rise_px = held;
+    sample.shake_y_px = -selection.shake_px[f];
+    sample.quality = std::isfinite(h) ? selection.quality[f] : 0.0;
+    if (!std::isfinite(h) || sample.quality < o.min_quality) ++track.poor_frames;
   }
-  const double dof = std::max(1.0, static_cast<double>(fit_y.size()) - 4);
-  const double variance =
-      std::isfinite(best.sse) ? std::max(noise_px * noise_px, best.sse / dof) : noise_px * noise_px;
+  for (size_t f : rest) rest_heights.push_back(selection.height_px[f]);
+  track.rest_rise_px = 0;
+  track.rest_noise_px = RobustSpread(rest_heights);
 
-  // the hinge's crossing, when the hinge follows the curve near the crossing: it strays
-  // from the frames there, and from the threshold at the local crossing, by less than half
-  // the threshold (or three times the noise)
-  double model_ns = local_ns, spread_ns = local_spread_ns;
-  bool use_model = false;
-  if (std::isfinite(best.sse)) {
-    const double crossing_s = best.CrossingS(threshold);
-    const double local_s = local_ns / 1e9;
-    const double at_local_px =
-        best.level +
-        best.gain * (local_s > best.t0_s ? std::pow(local_s - best.t0_s, best.power) : 0.0);
-    const double tolerance_px = std::max(0.5 * threshold, 3 * noise_px);
-    if (wobble_px <= tolerance_px && std::abs(at_local_px - threshold) <= tolerance_px &&
-        std::isfinite(crossing_s) && crossing_s >= fit_t.front() && crossing_s <= fit_t.back()) {
-      use_model = true;
-      model_ns = crossing_s * 1e9;
-      const double since_knee_s = crossing_s - best.t0_s;
-      if (since_knee_s > 0) {  // the hinge's slope there, px per ns
-        slope = best.gain * best.power * std::pow(since_knee_s, best.power - 1) / 1e9;
-      }
-      // every hinge within two standard deviations of the best: the range of its crossings
-      double lo = model_ns, hi = model_ns;
-      for (const Hinge& hinge : hinges) {
-        if (hinge.sse > best.sse + 4 * variance) continue;
-        const double c = hinge.CrossingS(threshold) * 1e9;
-        if (!std::isfinite(c)) continue;
-        lo = std::min(lo, c);
-        hi = std::max(hi, c);
-      }
-      spread_ns = std::max({model_ns - lo, hi - model_ns, step_s * 1e9});
-      if (slope > 0) spread_ns = std::hypot(spread_ns, 2 * rest_error_px / slope);
-    } else {
-      track.warnings.push_back(
-          "the rise does not follow a flat-then-rising curve near the threshold (rms " +
-          FormatFixed(wobble_px, 2) + " px): the threshold instant is interpolated locally");
+  // the liftoff
+  const LiftoffSearch search = FindLiftoff(samples, selection.height_px, rest.front(),
+                                           track.threshold_px, track.rest_noise_px,
+                                           o.compression_error_px > 0);
+  track.max_rise_px = search.max_rise_px;
+  if (!search.not_found.empty()) return NotFoundError(search.not_found);
+  const internal::RiseFit& fit = search.fit;
+  // with a codec's lag the fit only bounds the instant: its middle
+  const double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
+  const double fit_spread =
+      std::max(crossing_s - fit.crossing_low_s, fit.crossing_high_s - crossing_s);
+  const double rate = std::max(fit.rate_at_crossing, 1e-9);
+  // a codec's lag at the crossing: up to the bound allowed for (at least the option's)
+  const double compression_s =
+      (search.lag_bound_px > 0 ? std::max(o.compression_error_px, search.lag_bound_px)
+                               : o.compression_error_px) /
+      rate;
+  const double scale_s =
+      track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px / rate : 0.0;
+  const double uncertainty_s = std::sqrt(fit_spread * fit_spread + compression_s * compression_s +
+                                         scale_s * scale_s);
+  track.above_threshold = MakeEvent(samples, crossing_s, uncertainty_s);
+  track.onset = MakeEvent(samples, fit.knee_s,
+                          std::max(fit.knee_s - fit.knee_low_s, fit.knee_high_s - fit.knee_s));
+  track.fit_first_frame = samples[search.fit_first].frame_index;
+  track.fit_last_frame = samples[search.fit_last].frame_index;
+  track.fit_noise_px = fit.noise;
+  AddConfidenceWarnings(track, selection, fit, uncertainty_s);
+  if (o.tape_colour) {
+    track.located_by_tape = ShowsTapeColour(s.patches, selection.foot, *o.tape_colour);
+    if (!track.located_by_tape) {
+      track.warnings.push_back("foot: the tracked foot does not show foot " +
+                               std::string(FootName(*o.tape_colour)) +
+                               "'s tape colour: check the verification image");
     }
   }
-  // the mean lag a lossy codec leaves in slow sub-pixel motion: a sawtooth whose rms is the
-  // misfit, so its mean is sqrt(3) times that, at most compression_error_px; it moves the
-  // whole rise late and is independent of the fit's spread, so it adds in quadrature
-  if (slope > 0) {
-    const double codec_lag_px = std::min(o.compression_error_px, std::sqrt(3.0) * wobble_px);
-    spread_ns = std::hypot(spread_ns, codec_lag_px / slope);
-  }
-  // systematic terms: the curve's misfit (not noise: it does not average out) and the scale's
-  if (slope > 0) {
-    spread_ns += wobble_px / slope;
-    if (track.px_per_mm_estimated) spread_ns += kEstimatedScaleFraction * threshold / slope;
-  }
-  const double crossing_ns = origin + (use_model ? model_ns : local_ns);
-  track.above_threshold.t_ns = RoundNs(crossing_ns);
-  track.above_threshold.uncertainty_ns = RoundNs(spread_ns + offset_uncertainty_ns);
-
-  // the onset: the best hinge's knee, its spread over the hinges within two deviations,
-  // widened by the time the hinge takes to rise by three times the misfit (smaller rises are
-  // lost in it: compression keeps a slowly starting foot still)
-  TimedEvent onset;
-  if (std::isfinite(best.sse)) {
-    double lo = best.t0_s, hi = best.t0_s;
-    for (const Hinge& hinge : hinges) {
-      if (hinge.sse > best.sse + 4 * variance) continue;
-      lo = std::min(lo, hinge.t0_s);
-      hi = std::max(hi, hinge.t0_s);
-    }
-    const double hidden_s = std::pow(3 * std::max(noise_px, wobble_px) / best.gain, 1 / best.power);
-    onset.t_ns = RoundNs(origin + best.t0_s * 1e9);
-    onset.uncertainty_ns =
-        RoundNs((std::max({best.t0_s - lo, hi - best.t0_s, step_s}) + hidden_s) * 1e9 +
-                offset_uncertainty_ns);
-  } else {
-    onset = track.above_threshold;
-    onset.uncertainty_ns += RoundNs(interval_ns);
-    track.warnings.push_back(
-        "no knee found in the height curve: the onset is the threshold "
-        "instant");
-  }
-
-  // the frames either side of each instant
-  const auto bracket = [&](TimedEvent& event) {
-    event.frame_before = samples.front().frame_index;
-    event.frame_after = samples.back().frame_index;
-    for (size_t i = 0; i < samples.size(); ++i) {
-      if (t_of(i) <= static_cast<double>(event.t_ns)) event.frame_before = samples[i].frame_index;
-      if (t_of(i) > static_cast<double>(event.t_ns)) {
-        event.frame_after = samples[i].frame_index;
-        break;
-      }
-    }
-  };
-  bracket(track.above_threshold);
-  bracket(onset);
-  track.onset = onset;
+  track.samples = std::move(samples);
   return track;
 }
 

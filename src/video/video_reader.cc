@@ -23,6 +23,7 @@ extern "C" {
 #include "liftoff/core/file.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "keyframes.h"
 #include "video_util.h"
 
 namespace liftoff::video {
@@ -233,6 +234,8 @@ struct VideoReader::Impl {
   double first_ms = 0.0;
   bool first_pending = true;
   bool ended = false;
+  // the key frames' presentation times, ns (empty when unknown)
+  std::vector<int64_t> keyframe_times_ns;
 
   int64_t next_index = 0;
   int64_t last_ns = 0;  // the last time handed out (read or repaired)
@@ -416,6 +419,15 @@ Result<VideoReader> VideoReader::Open(const fs::path& path, const Options& optio
   }
   impl->width_px = impl->first_bgr.cols;
   impl->height_px = impl->first_bgr.rows;
+  {
+    DecoderLog ignored;  // a damaged file's complaints were counted once already
+    CatchDecoderLog catching(ignored);
+    Result<std::vector<int64_t>> keyframes = internal::ReadKeyframeTimesNs(path);
+    if (keyframes.ok() && !keyframes->empty()) {
+      impl->keyframe_times_ns = std::move(*keyframes);
+      impl->report.keyframes_known = true;
+    }
+  }
   return VideoReader(std::move(impl));
 }
 
@@ -463,6 +475,11 @@ Result<bool> VideoReader::Next(Frame& frame) {
   frame.index = impl.next_index++;
   frame.t_ns = impl.TimeOf(frame.index, position_ms, repaired);
   frame.t_repaired = repaired;
+  // a key frame by its time (within a tenth of a millisecond: OpenCV's times are the
+  // same packets' times in ms); unknown: every frame is one
+  frame.keyframe = !impl.report.keyframes_known ||
+                   (!repaired && internal::NearAny(impl.keyframe_times_ns, frame.t_ns, 100000));
+  if (frame.keyframe) ++impl.report.keyframes;
   impl.Record(frame.index, frame.t_ns, repaired);
   return true;
 }

@@ -119,8 +119,9 @@ TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
   options.rest_from_ns = options.rest_to_ns = 0;  // the first frames
   options.rest_frames = 3;
   FootTracker tracker(options);
-  // three frames at rest, then frames whose mid-exposure shows the foot at these heights
-  std::vector<double> heights_px = {0,   0,   0,   0.05, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9,
+  // six frames at rest (the first four make the templates), then frames whose mid-exposure
+  // shows the foot at these heights
+  std::vector<double> heights_px = {0, 0, 0, 0, 0, 0, 0.05, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9,
                                     1.0, 1.3, 1.7, 2.0,  2.5, 3.0,  4.5, 6.0, 9.0, 13.0, 18.0};
   const double px_per_mm = scene.renderer.px_per_mm();
   std::vector<int64_t> times_ns;
@@ -140,14 +141,15 @@ TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
   for (size_t i = 0; i < heights_px.size(); ++i) {
     const double truth_px = scene.TrueRisePx(times_ns[i]);
     EXPECT_NEAR(track->samples[i].rise_px, truth_px, 0.02) << "at " << heights_px[i] << " px";
-    EXPECT_GT(track->samples[i].quality, 0.95);
+    if (i >= 3) {
+      EXPECT_GT(track->samples[i].quality, 0.95) << "frame " << i;
+    }
   }
   // the foot as located: its bottom edge and width against the renderer's placement
   const auto& place = scene.renderer.placement(Foot::kA);
   EXPECT_NEAR(track->foot_bottom_px, place.bottom_px, 0.5);
   EXPECT_NEAR(track->foot_center_x_px, place.center_x_px, 0.5);
   EXPECT_NEAR(track->foot_width_px, place.width_px, 0.5);
-  EXPECT_LT(track->template_last_row, place.bottom_px);  // never the ground below the foot
 }
 
 TEST(FootTracker, CameraShakeIsMeasuredAndRemoved) {
@@ -174,15 +176,6 @@ TEST(FootTracker, CameraShakeIsMeasuredAndRemoved) {
   EXPECT_NEAR(static_cast<double>(track->above_threshold.t_ns), static_cast<double>(truth_ns),
               0.5 * static_cast<double>(scene.frame_ns));
 
-  // a reference region given by hand (here: the first one chosen) is used as given
-  FootTracker::Options by_hand = OptionsFor(scene);
-  by_hand.reference_roi_px = track->reference_patches_px.front();
-  Result<FootTrack> given = TrackClip(scene, by_hand);
-  ASSERT_TRUE(given.ok()) << given.status().ToString();
-  ASSERT_EQ(given->reference_patches_px.size(), 1u);
-  EXPECT_EQ(given->reference_roi_px, by_hand.reference_roi_px);
-  EXPECT_NEAR(static_cast<double>(given->above_threshold.t_ns), static_cast<double>(truth_ns),
-              0.5 * static_cast<double>(scene.frame_ns));
 }
 
 TEST(FootTracker, ShadowChangeAloneIsNotALift) {
@@ -406,12 +399,6 @@ TEST(FootTracker, RegionOutsideTheFrameIsInvalidArgument) {
   EXPECT_EQ(left_of_it.Process(frame).message(),
             "foot ROI -5x100+40x60 is outside the 640x480 frame");
 
-  options.foot_roi_px = cv::Rect(100, 100, 40, 60);
-  options.reference_roi_px = cv::Rect(620, 10, 40, 40);
-  FootTracker with_reference(options);
-  const Status reference = with_reference.Process(frame);
-  EXPECT_EQ(reference.code(), StatusCode::kInvalidArgument);
-  EXPECT_NE(reference.message().find("reference ROI 620x10+40x40 is outside"), std::string::npos);
 }
 
 TEST(FootTracker, InvalidOptionsAreRejectedNamingTheField) {
@@ -429,8 +416,6 @@ TEST(FootTracker, InvalidOptionsAreRejectedNamingTheField) {
   EXPECT_NE(message([](auto& o) { o.foot_width_mm = 0; }).find("foot_width_mm"), std::string::npos);
   EXPECT_NE(message([](auto& o) { o.rest_frames = 1; }).find("rest_frames"), std::string::npos);
   EXPECT_NE(message([](auto& o) { o.exposure_s = -1; }).find("exposure_s"), std::string::npos);
-  EXPECT_NE(message([](auto& o) { o.confirm_frames = 0; }).find("confirm_frames"),
-            std::string::npos);
   EXPECT_NE(message([](auto& o) { o.min_quality = 2; }).find("min_quality"), std::string::npos);
 
   // the tracker reports its options' error

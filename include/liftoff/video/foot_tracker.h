@@ -1,36 +1,42 @@
-// The foot: its vertical position to sub-pixel precision, frame by frame, against the
-// ground and the rest of the scene (camera shake measured on a reference region and
-// removed; the foot's shadow on the ground is not the foot), and the liftoff instants:
-// the onset of rise (the knee of the height curve) and the first instant the foot is
-// above its rest height by a threshold (px, or mm with a pixel scale; default 1 mm).
+// The foot: its vertical motion to sub-pixel precision, frame by frame, against the static
+// ground around it, and the liftoff instants: the onset of rise (the knee of the height
+// curve) and the first instant the foot is above its rest height by a threshold (px, or mm
+// with a pixel scale; default 1 mm). Nothing is assumed of the foot's shape, colour or of
+// the view: the foot is whatever in its region rises against the ground.
 //
 // Method:
-//   - First frame: the foot is located in its region (its width and centre from its side
-//     edges, or from its tape band when the tape colour is given; its bottom edge near the
-//     region's bottom). The template is the colour profile down the foot's central columns
-//     (30 % of its width), averaged across them, from one foot width above the bottom edge
-//     to 2 px above it: the foot, its tape band and what holds it, never the ground or the
-//     shadow below the foot. Up to three textured patches of the ground beside the foot
-//     (clear of the foot, its shadow and the leg above it) are the shake references.
-//   - Every frame: each reference patch's translation is measured by registering its
-//     column- and row-averaged profiles against the first frame's; the shake is their
-//     median. The foot's profile is taken at the shake-corrected columns and registered
-//     against the template along the vertical only: current(y) = gain * template(y - d)
-//     + offset, the template interpolated linearly between rows, which a least-squares
-//     fit solves in closed form per pixel interval (gain and offset absorb flicker). The
-//     rise is the shake minus the foot's shift d.
-//   - Finish: the rest level and noise over the rest window; the first sustained crossing
-//     of the threshold; a hinge (flat, then rising as a power 1 .. 3 of the time since its
-//     knee) fitted from the rest window to five thresholds up. The knee is the onset; the
-//     hinge's crossing of the threshold is the liftoff instant (a line through the frames
-//     around the crossing when the hinge does not follow the curve there). The hinge
-//     averages over the stepwise updates a codec makes of slow sub-pixel motion (H.264
-//     lets a slowly rising foot lag by up to ~0.4 px, then catch up). Instants are dated
-//     at the frames' mid-exposure.
-// Assumptions: the camera looks at the foot from the side, roughly level; the foot is
-// darker or brighter than the ground beside it; whatever holds the foot (a leg) covers
-// the central 30 % of the foot's width up to one foot width above its bottom; the region
-// of interest ends at most a quarter of the foot's width below the foot's bottom edge.
+//   - The work image: the foot region with a margin of 30 % of its size on every side,
+//     scaled down so that the region's smaller side is at most 64 px, as float BGR.
+//   - Patches: the mean of the first 4 frames is cut into 9 x 9 px candidate patches (work
+//     px, every 3 px); those with the strongest vertical texture are kept, none overlapping
+//     another by more than half: up to 56 inside the region, 24 in the margin.
+//   - Every frame: each patch is registered against its template (translation, gain and
+//     offset, Gauss-Newton from the previous frame's position: src/video/patch_registration.h).
+//     A patch whose residual jumps (occlusion, the foot leaving it) is not measured in that
+//     frame and is dropped after 8 such frames in a row. Per frame only the patches' vertical
+//     positions are kept (4 bytes a patch).
+//   - Finish: each patch's rest level is its median over the rest window. The ground is
+//     the patches that end (median of the last 0.5 s) within 0.5 px of where they rested;
+//     their median per frame is the camera's shake. The foot is the region's patches that
+//     end highest (at least 60 % of the second highest's rise) and move with one another;
+//     its height is their median per frame less the shake. A shadow changes but does not
+//     rise with the foot, a reflection in a glossy floor moves down, the ground stays:
+//     none of them is the foot.
+//   - The liftoff: the height curve's running median (0.15 s either side) must stay above
+//     the threshold for 0.5 s (at least 5 frames) and reach five thresholds (at least 3 px):
+//     a rise that goes on rising; no single frame decides. From there back to where the
+//     curve rests (at most 3 s of rest; a step within the rest ends it), the model "flat,
+//     then level + slope t + curvature t^2, both >= 0" is fitted with a robust (Huber) loss
+//     over a grid of knees (src/video/rise_fit.h). The crossing of the fitted level plus
+//     the threshold is the liftoff instant; the knee is the onset. Uncertainty: the spread
+//     of crossings of every knee that fits within a two-sigma loss increase (the noise
+//     inflated by its frame-to-frame correlation, as codecs update slow motion in steps),
+//     with a codec's sub-pixel lag (compression_error_px) over the rise rate, and 3 % of
+//     the threshold when the scale is estimated, in quadrature.
+//   - A frame's time is the middle of its exposure (the frame shows the foot there).
+// Limits: the foot region must show the foot at rest with room above it to rise and some
+// static ground; the clip must go on for about 0.5 s after the foot is five thresholds up;
+// a foot that rises less than about 1.5 px in all is "never lifts".
 #pragma once
 
 #include <cstdint>
@@ -52,14 +58,15 @@ struct HeightSample {
   int64_t frame_index = 0;
   /// The frame's time (Frame::t_ns: the start of its exposure), video clock, ns.
   int64_t t_ns = 0;
-  /// Foot's upward displacement from its position in the reference (first) frame, image
-  /// px (up positive), shake removed.
+  /// Foot's upward displacement from its rest, image px (up positive), shake removed
+  /// (a frame where the foot was not measured holds the previous value, quality 0).
   double rise_px = 0.0;
   /// Camera shake measured on the reference region, px (image y, down positive).
   double shake_y_px = 0.0;
-  /// Match quality of the foot's template (the fraction of the profile's variance the
-  /// fit explains), 0..1 (low: occluded, blurred, lost).
+  /// Fraction of the foot's patches measured in this frame, 0..1 (low: occluded, lost).
   double quality = 1.0;
+  /// Frame::keyframe: the frame shows the foot where it is (no codec lag).
+  bool keyframe = true;
 };
 
 /// An instant with its uncertainty.
@@ -76,20 +83,21 @@ struct TimedEvent {
 struct FootTrack {
   /// Every frame's sample, in order (40 bytes a frame: the only per-frame state kept).
   std::vector<HeightSample> samples;
-  /// Region tracked and the reference region used for shake, px (the bounding box of
-  /// reference_patches_px; empty when no reference was found and shake is not removed).
+  /// Region tracked and the bounding box of the ground patches, px (empty when no static
+  /// ground was found and shake is not removed).
   cv::Rect foot_roi_px;
   cv::Rect reference_roi_px;
-  /// The reference patches whose median translation is the shake, px (first frame).
+  /// The ground patches whose median motion is the shake, px (at rest).
   std::vector<cv::Rect> reference_patches_px;
-  /// The foot as located in the first frame, px: centre column, width, bottom edge row
-  /// (subpixel; pixel centres at integers), and the rows of its template [first, last].
+  /// The patches that moved with the foot, px (at rest).
+  std::vector<cv::Rect> foot_patches_px;
+  /// The foot's patches' bounding box at rest, px: centre column, width, bottom row
+  /// (pixel centres at integers).
   double foot_center_x_px = 0.0;
   double foot_width_px = 0.0;
   double foot_bottom_px = 0.0;
-  int template_first_row = 0;
-  int template_last_row = 0;
-  /// Whether the foot was located by its tape colour (Options::tape_colour).
+  /// Whether the tracked foot shows the tape colour of Options::tape_colour (false without
+  /// one): a check, never a requirement.
   bool located_by_tape = false;
   /// Rest: mean rise over the rest window, px, and its noise (standard deviation), px.
   double rest_rise_px = 0.0;
@@ -102,20 +110,21 @@ struct FootTrack {
   double threshold_px = 0.0;
   /// Largest rise above rest after the start of the rest window, px.
   double max_rise_px = 0.0;
-  /// Samples are dated at mid-exposure: frame t_ns + this, ns (exposure / 2; a quarter
-  /// of the frame interval when the exposure is unknown).
+  /// Samples are dated at frame t_ns + this, ns: 0, a frame's time being the middle of its
+  /// exposure.
   int64_t exposure_offset_ns = 0;
+  /// Frames the liftoff model was fitted over [first, last] (Frame::index), and the
+  /// robust standard deviation of its residuals, px.
+  int64_t fit_first_frame = 0;
+  int64_t fit_last_frame = 0;
+  double fit_noise_px = 0.0;
+  /// True when the evidence is weak (few foot patches, a noisy curve, a wide interval, a
+  /// clip that ends soon after the liftoff): the warnings say which.
+  bool low_confidence = false;
   /// Frames left out of the rest level and the instants for a poor match.
   int64_t poor_frames = 0;
-  /// Onset of rise (knee of the height curve) and first instant above the threshold,
-  /// video clock (mid-exposure). The onset's uncertainty spans every knee a hinge fit
-  /// allows within two standard deviations, plus the time the hinge takes to rise by three
-  /// times its misfit near the crossing (a smooth knee is poorly defined, and compression
-  /// holds a slowly starting foot still). The threshold instant's spans the crossings of
-  /// those hinges and the rest level's error, with the codec's mean sub-pixel lag over the
-  /// slope in quadrature (Options::compression_error_px), plus the misfit over the slope,
-  /// 3 % of the threshold when the scale is estimated, and the exposure's timing when
-  /// unknown.
+  /// Onset of rise (the fitted model's knee) and first instant above the threshold (its
+  /// crossing), video clock, with the uncertainties described above.
   TimedEvent onset;
   TimedEvent above_threshold;
   std::vector<std::string> warnings;
@@ -130,14 +139,15 @@ class FootTracker {
   struct Options {
     /// Region around the foot, px: the foot at rest and room above it to rise (required).
     cv::Rect foot_roi_px;
-    /// The foot whose tape colour to use (A blue, B orange, C purple, D red); empty:
-    /// use brightness edges only.
+    /// The foot whose tape colour the tracked foot should show (A blue, B orange, C purple,
+    /// D red): a check reported as FootTrack::located_by_tape, never used to find it.
     std::optional<Foot> tape_colour;
     /// Threshold above rest: in mm with a scale (px_per_mm given, or estimated from the
     /// foot's width foot_width_mm when px_per_mm is 0), or in px when threshold_px > 0
     /// (then mm are ignored). foot_width_mm is the width of the foot as seen from the
-    /// camera, mm: 40 mm is the synthetic scenes' rubber block; a real foot's width must
-    /// be given (or px_per_mm), or the estimated scale is wrong by their ratio.
+    /// camera, mm (a parameter of the robot, not of liftoff's synthetic block): give the
+    /// real foot's width, or better px_per_mm, else the estimated scale is wrong by their
+    /// ratio.
     double threshold_mm = 1.0;
     double threshold_px = 0.0;
     double px_per_mm = 0.0;
@@ -148,26 +158,17 @@ class FootTracker {
     int64_t rest_from_ns = 0;
     int64_t rest_to_ns = 0;
     int rest_frames = 15;
-    /// Region for camera shake, px; empty: chosen automatically beside the foot region.
-    /// It must show static, textured ground (not the foot, its shadow or another foot).
-    cv::Rect reference_roi_px;
-    /// Camera exposure time, s; 0 = unknown (taken as half the frame interval). A frame
-    /// shows the foot's mean position over its exposure, so samples are dated at
-    /// mid-exposure when the instants are computed.
+    /// Camera exposure time, s; 0 = unknown. Only checked (at most the frame interval): a
+    /// frame's time is the middle of its exposure, where it shows the foot.
     double exposure_s = 0.0;
     /// The largest mean offset a lossy codec leaves in the foot's sub-pixel position while
-    /// it moves slowly, px, >= 0: H.264 lets a slowly rising foot lag by 0 .. ~0.4 px,
-    /// then catch up, so the curve runs late by up to ~0.2 px on average, which no fit can
-    /// see. The lag is a sawtooth about the hinge whose rms is the hinge's misfit m, so the
-    /// offset used is min(sqrt(3) m, this); over the slope at the crossing, it is added in
-    /// quadrature to the threshold instant's spread. AnalyzeClip sets 0 for a lossless
-    /// codec (FrameTimingReport::lossless_codec).
+    /// it moves slowly, px, >= 0 (H.264 lets a slowly rising foot lag, then catch up):
+    /// over the rise rate at the crossing, added in quadrature to the liftoff instant's
+    /// uncertainty. AnalyzeClip sets 0 for a lossless codec
+    /// (FrameTimingReport::lossless_codec).
     double compression_error_px = 0.2;
-    /// A crossing counts only when this many consecutive frames are above the threshold
-    /// (a noise spike is not a liftoff), >= 1.
-    int confirm_frames = 3;
-    /// Frames whose match quality is below this are left out of the rest level and the
-    /// instants, 0..1.
+    /// Frames where fewer than this fraction of the foot's patches were measured count as
+    /// poor frames (FootTrack::poor_frames), 0..1.
     double min_quality = 0.5;
 
     Status Validate() const;
@@ -179,19 +180,18 @@ class FootTracker {
   ~FootTracker();
 
   /// Feeds the next frame. kInvalidArgument when the foot region is not inside the frame
-  /// ("foot ROI 600x400+80x90 is outside the 640x480 frame"; the reference region too),
-  /// when the options do not validate, when the picture is not BGR 8-bit or changes size,
-  /// or when t_ns does not increase. The first frame is the reference: the foot is
-  /// located and its template taken there (~0.7 ms at 720p); each frame after costs
-  /// ~0.06 ms at 720p or 1080p.
+  /// ("foot ROI 600x400+80x90 is outside the 640x480 frame"), when the options do not
+  /// validate, when the picture is not BGR 8-bit or changes size, or when t_ns does not
+  /// increase. The first 4 frames make the templates; every frame after registers the
+  /// patches (bench/video_bench prints the cost).
   Status Process(const Frame& frame);
   /// Sets the rest window after the fact (the LED instant is known only at the end of a
   /// single pass); overrides Options::rest_from_ns/rest_to_ns.
   void SetRestWindow(int64_t rest_from_ns, int64_t rest_to_ns);
   /// The result. kNotFound "the foot never lifts" (with its largest rise in the message)
-  /// when it never stays above the threshold from the start of the rest window on;
-  /// kInvalidArgument when no frame was fed, the options do not validate, or the rest
-  /// window holds no frame with a clear view of the foot. May be called more than once;
+  /// when nothing in the region rises for good above the threshold, or when the region
+  /// shows nothing to track; kInvalidArgument when no frame was fed, the options do not
+  /// validate, or the rest window holds no measured frame. May be called more than once;
   /// on an expiring tracker (std::move(tracker).Finish()) the samples move into the result
   /// instead of being copied, and the tracker is left without them.
   Result<FootTrack> Finish() const&;
@@ -200,8 +200,8 @@ class FootTracker {
   const std::vector<HeightSample>& samples() const;
 
  private:
-  // everything but the samples
-  Result<FootTrack> FinishWithoutSamples() const;
+  // the result around `samples` (the tracker's, copied or moved)
+  Result<FootTrack> FinishWith(std::vector<HeightSample> samples) const;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -21,6 +21,11 @@ struct Frame {
   /// The picture, CV_8UC3 BGR. Valid until the reader decodes the next frame: detectors
   /// that keep pixels must copy them.
   cv::Mat bgr;
+  /// True when the frame was coded on its own (a key frame: every frame of an intra-only
+  /// codec such as MJPEG or FFV1, and frames not read from a file): it shows the scene as it
+  /// is. False for predicted frames of H.264 and the like, which may hold slowly moving
+  /// parts still and let them catch up later.
+  bool keyframe = true;
 };
 
 }  // namespace liftoff::video

@@ -66,6 +66,10 @@ struct FrameTimingReport {
   /// printed): damage the decoder concealed, or that ended the stream. The first one's text.
   int64_t decoder_errors = 0;
   std::string first_decoder_error;
+  /// Key frames among the decoded frames (Frame::keyframe), and whether the file's packets
+  /// said which they are (when not, every frame counts as a key frame).
+  int64_t keyframes = 0;
+  bool keyframes_known = false;
   /// "1432 frames at 60.00 fps, 16.667 ms median interval, 3 dropped, 2 repaired, 0 irregular"
   /// (", 2 decoder errors" appended when there were any).
   std::string Brief() const;

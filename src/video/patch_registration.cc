@@ -1,0 +1,116 @@
+#include "patch_registration.h"
+
+#include <cmath>
+
+namespace liftoff::video::internal {
+namespace {
+
+// Bilinear sample of every channel at (x, y); false outside [0, cols - 1] x [0, rows - 1].
+inline bool Sample(const cv::Mat& image, double x, double y, int channels, float* out) {
+  if (!(x >= 0 && y >= 0 && x <= image.cols - 1 && y <= image.rows - 1)) return false;
+  const int x0 = std::min(static_cast<int>(x), image.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), image.rows - 2);
+  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+  const float* row0 = image.ptr<float>(y0) + x0 * channels;
+  const float* row1 = image.ptr<float>(y0 + 1) + x0 * channels;
+  for (int c = 0; c < channels; ++c) {
+    const float top = row0[c] + fx * (row0[c + channels] - row0[c]);
+    const float bottom = row1[c] + fx * (row1[c + channels] - row1[c]);
+    out[c] = top + fy * (bottom - top);
+  }
+  return true;
+}
+
+}  // namespace
+
+PatchTemplate MakePatchTemplate(const cv::Mat& image, cv::Point origin_px, int size_px) {
+  PatchTemplate patch;
+  patch.origin_px = cv::Point2d(origin_px.x, origin_px.y);
+  patch.size_px = size_px;
+  patch.channels = image.channels();
+  const int channels = patch.channels;
+  const size_t count = static_cast<size_t>(size_px * size_px * channels);
+  patch.values.resize(count);
+  patch.gradient_x.resize(count);
+  patch.gradient_y.resize(count);
+  cv::Matx44d normal = cv::Matx44d::zeros();
+  size_t k = 0;
+  for (int y = 0; y < size_px; ++y) {
+    const float* above = image.ptr<float>(origin_px.y + y - 1) + origin_px.x * channels;
+    const float* row = image.ptr<float>(origin_px.y + y) + origin_px.x * channels;
+    const float* below = image.ptr<float>(origin_px.y + y + 1) + origin_px.x * channels;
+    for (int x = 0; x < size_px; ++x) {
+      for (int c = 0; c < channels; ++c, ++k) {
+        const int i = x * channels + c;
+        const double value = static_cast<double>(row[i]);
+        const double gx = 0.5 * static_cast<double>(row[i + channels] - row[i - channels]);
+        const double gy = 0.5 * static_cast<double>(below[i] - above[i]);
+        patch.values[k] = static_cast<float>(value);
+        patch.gradient_x[k] = static_cast<float>(gx);
+        patch.gradient_y[k] = static_cast<float>(gy);
+        const cv::Vec4d j(gx, gy, -value, -1.0);
+        normal += j * j.t();
+      }
+    }
+  }
+  patch.normal = normal;
+  patch.texture_x = normal(0, 0) / static_cast<double>(count);
+  patch.texture_y = normal(1, 1) / static_cast<double>(count);
+  // the translation must be pinned apart from brightness: its block of the inverse finite
+  double condition = 0;
+  patch.normal_inverse = normal.inv(cv::DECOMP_SVD);
+  const cv::Matx22d translation(normal(0, 0), normal(0, 1), normal(1, 0), normal(1, 1));
+  const double trace = translation(0, 0) + translation(1, 1);
+  const double det = cv::determinant(translation);
+  const double disc = std::sqrt(std::max(0.0, trace * trace / 4 - det));
+  const double smallest = trace / 2 - disc;
+  condition = smallest / std::max(1e-12, trace / 2 + disc);
+  patch.usable = smallest > 0 && condition > 1e-4 && std::isfinite(patch.normal_inverse(0, 0));
+  return patch;
+}
+
+PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::Point2d guess_px,
+                         int max_iterations, double tolerance_px) {
+  PatchMatch match;
+  match.origin_px = guess_px;
+  const int channels = patch.channels;
+  std::vector<float> sample(static_cast<size_t>(channels));
+  for (int iteration = 1; iteration <= max_iterations; ++iteration) {
+    // residual of the current estimate and its projection on the template's Jacobian
+    cv::Vec4d projection(0, 0, 0, 0);
+    double sum_sq = 0;
+    size_t k = 0;
+    for (int y = 0; y < patch.size_px; ++y) {
+      for (int x = 0; x < patch.size_px; ++x) {
+        if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels,
+                    sample.data())) {
+          match.iterations = iteration;
+          return match;
+        }
+        for (int c = 0; c < channels; ++c, ++k) {
+          const double value = static_cast<double>(patch.values[k]);
+          const double model = (1 + match.gain) * value + match.offset;
+          const double residual = static_cast<double>(sample[static_cast<size_t>(c)]) - model;
+          sum_sq += residual * residual;
+          projection += cv::Vec4d(static_cast<double>(patch.gradient_x[k]),
+                                  static_cast<double>(patch.gradient_y[k]), -value, -1) *
+                        residual;
+        }
+      }
+    }
+    match.residual_rms = std::sqrt(sum_sq / static_cast<double>(k));
+    match.iterations = iteration;
+    // image(x + d) - (1 + g) t(x) - o ~ grad t . step - t dg - do
+    const cv::Vec4d step = patch.normal_inverse * projection;
+    if (!std::isfinite(step[0]) || !std::isfinite(step[1])) return match;
+    match.origin_px.x -= step[0];
+    match.origin_px.y -= step[1];
+    match.gain -= step[2];
+    match.offset -= step[3];
+    if (std::hypot(step[0], step[1]) < tolerance_px) break;
+  }
+  match.ok = std::isfinite(match.origin_px.x) && std::isfinite(match.origin_px.y);
+  return match;
+}
+
+}  // namespace liftoff::video::internal

@@ -1,0 +1,229 @@
+#include "rise_fit.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+namespace liftoff::video::internal {
+namespace {
+
+// Least noise assumed, a fraction of the threshold (a frozen, codec-held curve has none).
+constexpr double kNoiseFloor = 0.05;
+
+struct Coefficients {
+  double level = 0, slope = 0, curvature = 0;
+};
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+double HuberWeight(double residual, double scale) {
+  const double a = std::abs(residual);
+  return a <= scale ? 1.0 : scale / a;
+}
+
+double HuberLoss(double residual, double scale) {
+  const double a = std::abs(residual);
+  return a <= scale ? a * a : 2 * scale * a - scale * scale;
+}
+
+// Weighted least squares of h ~ level + slope u + curvature u^2 (u = max(0, t - knee)) with
+// slope, curvature >= 0: the unconstrained solution, else the best of the constrained
+// subsets (an active-set search over two sign constraints).
+Coefficients SolveWeighted(const std::vector<double>& t, const std::vector<double>& h,
+                           const std::vector<double>& w, double knee) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  double sum_w_h2 = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double u = std::max(0.0, t[i] - knee);
+    const Eigen::Vector3d row(1.0, u, u * u);
+    normal += w[i] * row * row.transpose();
+    rhs += w[i] * h[i] * row;
+    sum_w_h2 += w[i] * h[i] * h[i];
+  }
+  Coefficients best;
+  double best_sse = std::numeric_limits<double>::infinity();
+  // subsets of {slope, curvature} left free, the level always free
+  const std::array<std::array<bool, 2>, 4> subsets = {{{true, true}, {true, false},
+                                                       {false, true}, {false, false}}};
+  for (const auto& free : subsets) {
+    std::array<Eigen::Index, 3> columns{};
+    Eigen::Index n = 0;
+    columns[static_cast<size_t>(n++)] = 0;
+    if (free[0]) columns[static_cast<size_t>(n++)] = 1;
+    if (free[1]) columns[static_cast<size_t>(n++)] = 2;
+    Eigen::MatrixXd a(n, n);
+    Eigen::VectorXd b(n);
+    for (Eigen::Index r = 0; r < n; ++r) {
+      const Eigen::Index row = columns[static_cast<size_t>(r)];
+      b(r) = rhs(row);
+      for (Eigen::Index c = 0; c < n; ++c) a(r, c) = normal(row, columns[static_cast<size_t>(c)]);
+    }
+    const Eigen::VectorXd x = a.ldlt().solve(b);
+    if (!x.allFinite()) continue;
+    Eigen::Vector3d full = Eigen::Vector3d::Zero();
+    for (Eigen::Index r = 0; r < n; ++r) full(columns[static_cast<size_t>(r)]) = x(r);
+    if (full(1) < 0 || full(2) < 0) continue;
+    const double sse = sum_w_h2 - 2 * full.dot(rhs) + full.dot(normal * full);
+    if (sse < best_sse) {
+      best_sse = sse;
+      best = {full(0), full(1), full(2)};
+    }
+  }
+  return best;
+}
+
+double Evaluate(const Coefficients& c, double knee, double t) {
+  const double u = std::max(0.0, t - knee);
+  return c.level + c.slope * u + c.curvature * u * u;
+}
+
+// How a sample counts against the model: the target it is compared with and its weight.
+// Lag-free samples: themselves, lag_free_weight. Samples that may lag, once the model
+// rises: above it, themselves; below it by at most lag_bound (a codec's possible lag),
+// themselves with lag_weight; further below, the bound's edge, in full.
+struct Term {
+  double target, weight;
+};
+Term TermOf(double h, double model, double t, double knee, bool lag_free,
+            const RiseFitOptions& options) {
+  if (lag_free) return {h, options.lag_free_weight};
+  if (t <= knee || h >= model) return {h, 1.0};
+  if (h >= model - options.lag_bound) return {h, options.lag_weight};
+  return {h + options.lag_bound, 1.0};
+}
+
+// Huber-weighted fit at one knee: its coefficients and its total loss.
+std::pair<Coefficients, double> FitAtKnee(const std::vector<double>& t,
+                                          const std::vector<double>& h,
+                                          const std::vector<bool>& lag_free, double knee,
+                                          double scale, const RiseFitOptions& options) {
+  std::vector<double> w(t.size(), 1.0), target = h;
+  Coefficients c;
+  for (int pass = 0; pass < options.passes; ++pass) {
+    c = SolveWeighted(t, target, w, knee);
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double model = Evaluate(c, knee, t[i]);
+      const Term term = TermOf(h[i], model, t[i], knee, lag_free[i], options);
+      target[i] = term.target;
+      w[i] = HuberWeight(term.target - model, scale) * term.weight;
+    }
+  }
+  double loss = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double model = Evaluate(c, knee, t[i]);
+    const Term term = TermOf(h[i], model, t[i], knee, lag_free[i], options);
+    loss += HuberLoss(term.target - model, scale) * term.weight;
+  }
+  return {c, loss};
+}
+
+// Time after the knee at which the model has risen by `threshold`; infinity if never.
+double TimeToRise(const Coefficients& c, double threshold) {
+  if (c.curvature > 0) {
+    return (-c.slope + std::sqrt(c.slope * c.slope + 4 * c.curvature * threshold)) /
+           (2 * c.curvature);
+  }
+  if (c.slope > 0) return threshold / c.slope;
+  return std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+double RiseModel(const RiseFit& fit, double t_s) {
+  return Evaluate({fit.level, fit.slope, fit.curvature}, fit.knee_s, t_s);
+}
+
+RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& height,
+                const std::vector<bool>& lag_free_in, const RiseFitOptions& options) {
+  RiseFit fit;
+  const size_t n = t_s.size();
+  if (n < 8 || height.size() != n || !(lag_free_in.empty() || lag_free_in.size() == n)) return fit;
+  const std::vector<bool> lag_free = lag_free_in.empty() ? std::vector<bool>(n, true) : lag_free_in;
+
+  // noise first from successive differences (model-free), then from the best fit's residuals
+  std::vector<double> differences;
+  for (size_t i = 1; i < n; ++i) differences.push_back(std::abs(height[i] - height[i - 1]));
+  double noise = std::max(1.4826 * Median(differences) / std::sqrt(2.0), kNoiseFloor * options.threshold);
+
+  // candidate knees: every sample time and the midpoints between them
+  std::vector<double> knees;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    knees.push_back(t_s[i]);
+    knees.push_back(0.5 * (t_s[i] + t_s[i + 1]));
+  }
+  std::vector<double> losses(knees.size());
+  std::vector<Coefficients> coefficients(knees.size());
+  size_t best = 0;
+  for (int round = 0; round < 2; ++round) {
+    const double scale = options.huber_k * noise;
+    double best_loss = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < knees.size(); ++k) {
+      auto [c, loss] = FitAtKnee(t_s, height, lag_free, knees[k], scale, options);
+      coefficients[k] = c;
+      losses[k] = (c.slope > 0 || c.curvature > 0) ? loss : std::numeric_limits<double>::infinity();
+      if (losses[k] < best_loss) {
+        best_loss = losses[k];
+        best = k;
+      }
+    }
+    if (!std::isfinite(best_loss)) return fit;
+    std::vector<double> residuals(n);
+    for (size_t i = 0; i < n; ++i) {
+      residuals[i] = height[i] - Evaluate(coefficients[best], knees[best], t_s[i]);
+    }
+    std::vector<double> absolute(n);
+    for (size_t i = 0; i < n; ++i) absolute[i] = std::abs(residuals[i]);
+    const double refined = 1.4826 * Median(absolute);
+    if (round == 0) {
+      noise = std::max(refined, kNoiseFloor * options.threshold);
+      continue;
+    }
+    // lag-one correlation of the residuals
+    double num = 0, den = 0;
+    for (size_t i = 0; i < n; ++i) {
+      den += residuals[i] * residuals[i];
+      if (i > 0) num += residuals[i] * residuals[i - 1];
+    }
+    fit.correlation = den > 0 ? std::clamp(num / den, 0.0, 0.95) : 0.0;
+  }
+
+  const Coefficients& c = coefficients[best];
+  fit.ok = true;
+  fit.knee_s = knees[best];
+  fit.level = c.level;
+  fit.slope = c.slope;
+  fit.curvature = c.curvature;
+  fit.noise = noise;
+  const double rise_time = TimeToRise(c, options.threshold);
+  fit.crossing_s = fit.knee_s + rise_time;
+  fit.rate_at_crossing = c.slope + 2 * c.curvature * rise_time;
+
+  // every knee within a two-sigma loss increase (noise inflated for correlated residuals)
+  const double inflation = (1 + fit.correlation) / (1 - fit.correlation);
+  const double allowed = 4.0 * noise * noise * inflation;
+  fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
+  fit.knee_low_s = fit.knee_high_s = fit.knee_s;
+  const double half_spacing = 0.5 * (t_s.back() - t_s.front()) / static_cast<double>(n - 1);
+  for (size_t k = 0; k < knees.size(); ++k) {
+    if (!(losses[k] - losses[best] <= allowed)) continue;
+    const double crossing = knees[k] + TimeToRise(coefficients[k], options.threshold);
+    if (!std::isfinite(crossing)) continue;
+    fit.crossing_low_s = std::min(fit.crossing_low_s, crossing - half_spacing);
+    fit.crossing_high_s = std::max(fit.crossing_high_s, crossing + half_spacing);
+    fit.knee_low_s = std::min(fit.knee_low_s, knees[k] - half_spacing);
+    fit.knee_high_s = std::max(fit.knee_high_s, knees[k] + half_spacing);
+  }
+  fit.crossing_middle_s = 0.5 * (fit.crossing_low_s + fit.crossing_high_s);
+  return fit;
+}
+
+}  // namespace liftoff::video::internal
