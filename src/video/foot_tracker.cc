@@ -31,6 +31,8 @@ using internal::RectText;
 // no more than small ones).
 constexpr double kMarginFraction = 0.3;
 constexpr double kWorkRegionPx = 64.0;
+// The work image is never enlarged (enlarging a small region was measured worse).
+constexpr double kMaxUpscale = 1.0;
 // Patch side in work px, and the spacing of candidate patches.
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
@@ -50,11 +52,13 @@ constexpr double kMaxGain = 0.5;
 // A patch is the foot's when its final rise is at least this fraction of the foot's largest
 // (patches on the foot's border with the ground move only in part).
 constexpr double kFootFraction = 0.8;
-// The fit ends where the rising curve stays above this many thresholds (at least
-// kFitTopPx px): high enough to pin the curvature and average over a codec's stepwise
-// updates, low enough for the model's two terms.
-constexpr double kFitTopThresholds = 8.0;
-constexpr double kFitTopPx = 4.0;
+// The fit ends where the rising curve reaches this many thresholds (at least this many
+// px): from a lossy codec, high enough to see past its lag (the model bridges the rest);
+// from a lossless one, close to the threshold, where the two-term model holds best.
+constexpr double kFitTopThresholdsLossy = 8.0;
+constexpr double kFitTopPxLossy = 4.0;
+constexpr double kFitTopThresholdsLossless = 3.0;
+constexpr double kFitTopPxLossless = 1.5;
 // A key frame this soon after the fit's top extends the fit to it, s.
 constexpr double kKeyframeReachS = 1.5;
 // Weight of samples within a codec's possible lag below the model, and the least lag
@@ -76,6 +80,8 @@ constexpr double kCoherencePx = 0.15;
 constexpr double kSustainS = 0.5;
 constexpr size_t kSustainFrames = 5;
 constexpr double kRestingS = 0.5;
+// Where a patch ends: its median over the clip's last this long, s.
+constexpr double kFinalS = 0.5;
 // Weak evidence: fewer foot (ground) patches than these, a curve noisier than this
 // fraction of the threshold, an instant more uncertain than this, a clip ending fewer
 // thresholds up than this.
@@ -206,7 +212,7 @@ void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
   work_px = cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
                      roi.height + 2 * margin_y) &
             cv::Rect(0, 0, size.width, size.height);
-  scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
+  scale = std::min(kMaxUpscale, kWorkRegionPx / std::min(roi.width, roi.height));
   const auto to_work = [&](int v, int origin) {
     return static_cast<int>(std::lround((v - origin) * scale));
   };
@@ -219,6 +225,8 @@ void FootTracker::Impl::MakeWorkImage(const cv::Mat& bgr) {
   cv::Mat crop = bgr(work_px), scaled;
   if (scale < 1) {
     cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+  } else if (scale > 1) {
+    cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_LINEAR);
   } else {
     scaled = crop;
   }
@@ -613,7 +621,10 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
     for (size_t f = rise; f < smooth.size(); ++f) {
       if (std::isfinite(smooth[f])) highest = std::max(highest, smooth[f]);
     }
-    const double top = std::min(std::max(kFitTopThresholds * threshold_px, kFitTopPx), 0.8 * highest);
+    const double top =
+        std::min(lossy ? std::max(kFitTopThresholdsLossy * threshold_px, kFitTopPxLossy)
+                       : std::max(kFitTopThresholdsLossless * threshold_px, kFitTopPxLossless),
+                 0.8 * highest);
     for (size_t f = rise; f < smooth.size() && cut == smooth.size(); ++f) {
       if (smooth[f] >= top) cut = f;
     }
@@ -833,8 +844,9 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
                                 FormatSeconds(s.rest_to_ns, 4) +
                                 " s holds no frame the foot tracker measured");
   }
-  const PatchSelection selection =
-      SelectPatches(table, s.patches, rest, frames, std::max<size_t>(5, FramesIn(samples, 0.5)));
+  // where patches end: their last 0.5 s
+  const size_t final_count = std::max<size_t>(kSustainFrames, FramesIn(samples, kFinalS));
+  const PatchSelection selection = SelectPatches(table, s.patches, rest, frames, final_count);
 
   FootTrack track;
   track.foot_roi_px = o.foot_roi_px;
