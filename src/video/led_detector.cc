@@ -95,10 +95,12 @@ constexpr double kRoiOppositeFrac = 0.5;
 // With an ROI, each row's flicker gain leaves out pixels brighter than this many times
 // the frame's gain (a light that switched on, not the lamp's flicker, up to +-50 %).
 constexpr double kRowRatioMax = 1.6;
-// The row beside the ROI is sampled every kStripStepPx px, and used with at least
-// kStripMinSamples samples.
-constexpr int kStripStepPx = 8;
-constexpr size_t kStripMinSamples = 16;
+// The row beside the ROI is sampled every kStripStepPx px, and used when that gives at
+// least kStripMinSamples samples a row.
+constexpr int kStripStepPx = 16;
+constexpr size_t kStripMinSamples = 8;
+// Rows share their flicker gain in bands of this many.
+constexpr int kGainBandRows = 4;
 // A lit pixel whose brightest channel reaches this level clips (a codec's rounding keeps a
 // clipped pixel within 2 levels of 255) (a partly lit frame then
 // looks brighter than its fraction); such pixels are left out of the dating series unless
@@ -379,6 +381,7 @@ struct LedDetector::Impl {
   std::vector<float> changes;
   std::vector<float> row_gains;  // ring x ROI rows
   std::vector<float> row_ratios;
+  std::vector<float> band_gains;
   std::vector<size_t> strip_columns;  // frame columns beside the ROI sampled for row gains
   std::vector<float> strip_reference;  // ROI rows x strip columns
   std::vector<float> strip_ring;       // ring x ROI rows x strip columns
@@ -468,8 +471,9 @@ struct LedDetector::Impl {
         }
       }
       strip_reference.assign(strip_columns.size() * static_cast<size_t>(roi.height), 0.0f);
+      band_gains.assign(static_cast<size_t>(GainBands()), 1.0f);
       strip_ring.assign(static_cast<size_t>(ring) * strip_reference.size(), 0.0f);
-      row_ratios.reserve(std::max(strip_columns.size(), static_cast<size_t>(roi.width)));
+      row_ratios.reserve(std::max(strip_columns.size() * static_cast<size_t>(kGainBandRows), static_cast<size_t>(roi.width)));
     }
     const auto slots = static_cast<size_t>(ring);
     ring_index.assign(slots, 0);
@@ -569,11 +573,11 @@ struct LedDetector::Impl {
 
   // the frame's rows beside the ROI (B + G + R every kStripStepPx px)
   void SampleStrips(const cv::Mat& bgr, float* strip) const {
-    const size_t samples = strip_columns.size();
+    const size_t columns = strip_columns.size();
     for (int y = 0; y < options.roi_px.height; ++y) {
       const uint8_t* line = bgr.ptr<uint8_t>(options.roi_px.y + y);
-      float* out = strip + static_cast<size_t>(y) * samples;
-      for (size_t s = 0; s < samples; ++s) {
+      float* out = strip + static_cast<size_t>(y) * columns;
+      for (size_t s = 0; s < columns; ++s) {
         const uint8_t* pixel = line + 3 * strip_columns[s];
         out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]);
       }
@@ -591,14 +595,19 @@ struct LedDetector::Impl {
   // leaving out pixels brighter than kRowRatioMax times the frame's gain (a lit light).
   void MeasureRowGains(const uint8_t* picture, const float* strip, double gain, float* gains) {
     const auto min_reference = static_cast<float>(3.0 * kGainMinLevels);
-    const size_t samples = strip_columns.size();
+    const size_t columns = strip_columns.size();
     const auto width = static_cast<size_t>(options.roi_px.width);
     const auto most = static_cast<float>(kRowRatioMax * gain);
-    for (int y = 0; y < options.roi_px.height; ++y) {
+    for (int band = 0; band < GainBands(); ++band) {
+      const int y = BandRow(band);
+      const int band_end = std::min(options.roi_px.height, (band + 1) * kGainBandRows);
+      const auto band_rows = static_cast<size_t>(band_end - band * kGainBandRows);
+      const size_t samples = columns * band_rows;
       row_ratios.clear();
-      if (samples >= kStripMinSamples) {
-        const float* reference = &strip_reference[static_cast<size_t>(y) * samples];
-        const float* brightness = strip + static_cast<size_t>(y) * samples;
+      if (columns >= kStripMinSamples) {
+        const size_t first = static_cast<size_t>(band * kGainBandRows) * columns;
+        const float* reference = &strip_reference[first];
+        const float* brightness = strip + first;
         for (size_t s = 0; s < samples; ++s) {
           if (reference[s] >= min_reference) row_ratios.push_back(brightness[s] / reference[s]);
         }
@@ -611,11 +620,31 @@ struct LedDetector::Impl {
           if (ratio < most) row_ratios.push_back(ratio);
         }
       }
-      const size_t needed = samples >= kStripMinSamples ? samples : width;
-      gains[y] = 2 * row_ratios.size() > needed
-                     ? MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size()))
-                     : static_cast<float>(gain);
+      const size_t needed = columns >= kStripMinSamples ? samples : width;
+      const float band_gain =
+          2 * row_ratios.size() > needed
+              ? MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size()))
+              : static_cast<float>(gain);
+      band_gains[static_cast<size_t>(band)] = band_gain;
     }
+    // every row: linear between the measured rows around it
+    for (int y = 0; y < options.roi_px.height; ++y) {
+      const int band = std::clamp((y - kGainBandRows / 2) / kGainBandRows, 0, GainBands() - 1);
+      const int next = std::min(band + 1, GainBands() - 1);
+      const int from = BandRow(band), to = BandRow(next);
+      const float weight =
+          to > from ? std::clamp(static_cast<float>(y - from) / static_cast<float>(to - from), 0.0f, 1.0f)
+                    : 0.0f;
+      gains[y] = band_gains[static_cast<size_t>(band)] +
+                 weight * (band_gains[static_cast<size_t>(next)] - band_gains[static_cast<size_t>(band)]);
+    }
+  }
+
+  // the ROI's rows in bands of kGainBandRows (banding changes slowly from row to row), each
+  // measured on all its rows and taken for its middle row; rows between are interpolated
+  int GainBands() const { return (options.roi_px.height + kGainBandRows - 1) / kGainBandRows; }
+  int BandRow(int band) const {
+    return std::min(band * kGainBandRows + kGainBandRows / 2, options.roi_px.height - 1);
   }
 
   double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain) {
