@@ -750,12 +750,14 @@ cv::Mat SceneRenderer::RenderFrame(int64_t frame_index, int64_t t_video_ns) {
   // 1. the static scene
   static_canvas_.copyTo(canvas_);
 
-  // 2. the moving feet at the midpoints of the exposure's equal parts
+  // 2. the moving feet at the midpoints of the exposure's equal parts (the exposure is
+  //    centred on the frame's timestamp)
+  const int64_t exposure_start_ns = ExposureStartNs(spec.camera, t_video_ns);
   const int samples = spec.nuisance.motion_blur_samples;
   std::vector<double> heights_m(static_cast<size_t>(samples));
   for (const MovingFoot& moving : moving_) {
     for (int i = 0; i < samples; ++i) {
-      const int64_t t_ns = t_video_ns + (2 * i + 1) * exposure_ns_ / (2 * samples);
+      const int64_t t_ns = exposure_start_ns + (2 * i + 1) * exposure_ns_ / (2 * samples);
       heights_m[static_cast<size_t>(i)] = timeline_.FootHeightMAt(moving.foot, t_ns);
     }
     ComposeMovingFoot(moving, heights_m, false, canvas_);
@@ -765,7 +767,8 @@ cv::Mat SceneRenderer::RenderFrame(int64_t frame_index, int64_t t_video_ns) {
   const double amplitude = spec.nuisance.flicker_amplitude;
   if (amplitude > 0) {
     const double omega = 2 * kPi * spec.nuisance.flicker_hz;
-    const double t0_s = SecondsFromNs(t_video_ns), t1_s = SecondsFromNs(t_video_ns + exposure_ns_);
+    const double t0_s = SecondsFromNs(exposure_start_ns);
+    const double t1_s = SecondsFromNs(exposure_start_ns + exposure_ns_);
     const double mean_sin =
         (std::cos(omega * t0_s) - std::cos(omega * t1_s)) / (omega * (t1_s - t0_s));
     canvas_.convertTo(canvas_, -1, 1 + amplitude * mean_sin);

@@ -217,6 +217,8 @@ std::vector<TrialSpec> CiSet() {
     TrialSpec spec = CiTrial(4, "foot-d-30fps", Foot::kD);
     spec.camera.fps = 30.0;
     spec.camera.exposure_s = 1.0 / 60.0;
+    // 60 % into frame 18's exposure, centred on 0.6 s: [0.6 - 1/120, 0.6 + 1/120)
+    spec.led.on_video_s = 0.6 + 0.1 / 60.0;
     add(spec);
   }
   // resolutions: 720p, and one short 1080p clip (a faster ramp, an earlier liftoff)
@@ -243,7 +245,7 @@ std::vector<TrialSpec> CiSet() {
     TrialSpec spec = CiTrial(7, "120fps-short-exposure", Foot::kB);
     spec.camera.fps = 120.0;
     spec.camera.exposure_s = 0.001;
-    spec.led.on_video_s = 0.6 + 0.0004;  // frame 72 starts at 0.6 s
+    spec.led.on_video_s = 0.6 - 0.0001;  // 0.4 ms into frame 72's [0.5995, 0.6005) s
     spec.motion.ramp_rate_rad_per_s = 0.3;
     add(spec);
   }
@@ -251,6 +253,8 @@ std::vector<TrialSpec> CiSet() {
     TrialSpec spec = CiTrial(8, "240fps", Foot::kD);
     spec.camera.fps = 240.0;
     spec.camera.exposure_s = 1.0 / 480.0;
+    // 80 % into frame 146's exposure (timestamp 146/240 s, the middle of it)
+    spec.led.on_video_s = 146.0 / 240.0 + 0.3 / 480.0;
     spec.motion.ramp_rate_rad_per_s = 0.4;
     spec.motion.height.liftoff_rad = 0.3;
     add(spec);
@@ -260,7 +264,8 @@ std::vector<TrialSpec> CiSet() {
     spec.camera.codec = VideoCodec::kFfv1;
     spec.camera.fps = 30.0;
     spec.camera.exposure_s = 1.0 / 30.0;
-    spec.led.on_video_s = 0.6 + 0.02;  // 60 % into frame 18's exposure
+    // 60 % into frame 18's exposure, centred on 0.6 s: [0.6 - 1/60, 0.6 + 1/60)
+    spec.led.on_video_s = 0.6 + 0.1 / 30.0;
     add(spec);
   }
   // variable frame rate

@@ -674,6 +674,10 @@ int64_t ExposureNs(const CameraSpec& camera) {
   return std::max<int64_t>(1, NsFromSeconds(camera.exposure_s));
 }
 
+int64_t ExposureStartNs(const CameraSpec& camera, int64_t t_frame_ns) {
+  return t_frame_ns - ExposureNs(camera) / 2;
+}
+
 std::optional<int64_t> LedOnVideoNs(const TrialSpec& spec) {
   const int64_t led_ns = NsFromSeconds(spec.led.on_video_s);
   if (spec.led.on_video_s < 0 || led_ns >= NsFromSeconds(spec.duration_s)) return std::nullopt;
@@ -684,7 +688,8 @@ double LedOnFractionOfExposure(const TrialSpec& spec, int64_t t_frame_ns) {
   const std::optional<int64_t> led_ns = LedOnVideoNs(spec);
   if (!led_ns) return 0.0;
   const int64_t exposure_ns = ExposureNs(spec.camera);
-  const int64_t on_ns = std::clamp(t_frame_ns + exposure_ns - *led_ns, int64_t{0}, exposure_ns);
+  const int64_t end_ns = ExposureStartNs(spec.camera, t_frame_ns) + exposure_ns;
+  const int64_t on_ns = std::clamp(end_ns - *led_ns, int64_t{0}, exposure_ns);
   return static_cast<double>(on_ns) / static_cast<double>(exposure_ns);
 }
 

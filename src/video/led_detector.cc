@@ -8,15 +8,22 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <limits>
+#include <numeric>
 #include <utility>
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "led_timing.h"
 #include "video_util.h"
 
 namespace liftoff::video {
 namespace {
 
+using internal::ExposureRange;
+using internal::InstantInterval;
+using internal::LitFraction;
 using internal::MedianOf;
 using internal::RectText;
 
@@ -64,15 +71,54 @@ constexpr double kGainMinLevels = 10.0;
 constexpr int kAutoRowStep = 2;
 constexpr int kGainStride = 2;
 constexpr int kReferenceStride = 4;
-// A measured fraction of the exposure is known to within max(sigmas * its noise, margin):
-// the margin covers what noise estimates from a few frames miss (codec effects at the
+// A measured fraction of the exposure is known to within max(sigmas * its noise, margin)
+// (3 sigmas of a frame's noise: the frame's own and that of the two levels it is measured
+// between, medians of a few frames); the margin covers what noise estimates from a few frames miss (codec effects at the
 // step), so a frame lit 92 % or more may have been lit all along.
-constexpr double kFractionSigmas = 2.0;
+constexpr double kFractionSigmas = 3.0;
 constexpr double kFractionMargin = 0.08;
 // A frame next to the step counts as partly lit above this fraction (or the noise band):
 // H.264's B-frames borrow a little of the next frame's light, so the frame before a
 // switch-on can look lit by a few percent.
 constexpr double kLitFraction = 0.15;
+// With an ROI, the detection signal sums the largest brightness changes of this many
+// pixels: a 256th of the ROI (a person draws it around the LED with a margin that grows
+// with the LED), at least 9 (a light of 1 px radius and its glow).
+constexpr size_t kTopPixelsMin = 9;
+constexpr size_t kTopPixelsShare = 256;
+// The pixels of a step: those whose step is above this many times a pixel's noise and
+// this fraction of the largest pixel step; pixels stepping the other way by more than
+// kRoiOppositeFrac of their total make it no light (an edge moved).
+constexpr double kPixelNoiseSigmas = 5.0;
+constexpr double kPixelStepFrac = 0.1;
+constexpr double kRoiOppositeFrac = 0.5;
+// With an ROI, each row's flicker gain leaves out pixels brighter than this many times
+// the frame's gain (a light that switched on, not the lamp's flicker, up to +-50 %).
+constexpr double kRowRatioMax = 1.6;
+// The row beside the ROI is sampled every kStripStepPx px, and used when that gives at
+// least kStripMinSamples samples a row.
+constexpr int kStripStepPx = 16;
+constexpr size_t kStripMinSamples = 8;
+// Rows share their flicker gain in bands of this many.
+constexpr int kGainBandRows = 4;
+// A lit pixel whose brightest channel reaches this level clips (a codec's rounding keeps a
+// clipped pixel within 2 levels of 255) (a partly lit frame then
+// looks brighter than its fraction); such pixels are left out of the dating series unless
+// the others carry less than kUnclippedShare of the step.
+constexpr double kClipLevels = 253.0;
+constexpr double kUnclippedShare = 0.25;
+// The pixels of a light hold their levels much better than a whole region: the frames
+// before and after a step must stay within this fraction of it.
+constexpr double kFlatFracPixels = 0.2;
+// The frames after a step may go on in its direction by at most this fraction of it (a
+// codec refines a small bright spot over a few frames), during its confirmation too.
+constexpr double kCreepFrac = 0.5;
+// The LED's contrast with an ROI: the brightest-channel step of its pixel of this rank
+// (0: the largest; 2 ignores two noisy pixels and keeps a light of 3 px).
+constexpr size_t kContrastRank = 2;
+// A region that stepped to a level steps again in the same direction only by more than
+// this many times that step.
+constexpr double kStrongerFactor = 3.0;
 // Intervals kept for the usual frame interval (the bound of an unknown exposure).
 constexpr size_t kIntervalWindow = 31;
 // Recorded steps per region at most (a region that keeps stepping is no sync LED).
@@ -87,6 +133,48 @@ double QuantileOf(std::vector<double>& values, double fraction) {
                                              fraction * static_cast<double>(values.size() - 1));
   std::nth_element(values.begin(), position, values.end());
   return *position;
+}
+
+// The shape of a window of a series around a step at its frame `before_count`: the
+// levels before and after (medians), the step between them (positive in the step's
+// direction), the spread of the frames before (the last one left out when it is already
+// up to threshold_frac of the way: a codec's B-frame borrows light from the next frame),
+// how far the frames after fall back against the step, and how far they go on in its
+// direction (a codec refines a small bright spot over a few frames).
+struct WindowShape {
+  double before_level = 0.0, after_level = 0.0, step = 0.0;
+  double before_spread = 0.0, after_against = 0.0, after_creep = 0.0;
+};
+
+WindowShape ShapeOf(const double* values, int before_count, int after_count, bool rise,
+                    double threshold_frac, std::vector<double>& scratch) {
+  const double sign = rise ? 1.0 : -1.0;
+  const auto before = static_cast<size_t>(before_count);
+  const auto after = static_cast<size_t>(after_count);
+  WindowShape shape;
+  scratch.assign(values, values + before + 1 + after);
+  shape.before_level = MedianOf(scratch.data(), before_count);
+  shape.after_level = MedianOf(scratch.data() + before + 1, after_count);
+  shape.step = sign * (shape.after_level - shape.before_level);
+  size_t flat_before = before;
+  if (before >= 3) {
+    scratch.assign(values, values + before - 1);
+    const double earlier = MedianOf(scratch.data(), before_count - 1);
+    const double ahead = sign * (values[before - 1] - earlier);
+    if (ahead > 0 && ahead < threshold_frac * shape.step) flat_before = before - 1;
+  }
+  const auto [low, high] = std::minmax_element(values, values + flat_before);
+  shape.before_spread = *high - *low;
+  double furthest = -std::numeric_limits<double>::infinity();
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t i = before + 1; i < before + 1 + after; ++i) {
+    const double along = sign * values[i];
+    furthest = std::max(furthest, along);
+    shape.after_against = std::max(shape.after_against, furthest - along);
+    least = std::min(least, along);
+    shape.after_creep = std::max(shape.after_creep, along - least);
+  }
+  return shape;
 }
 
 // The cells of the automatic locator: origins of every cell column and row (the last one
@@ -179,90 +267,26 @@ void MeasureCells(const cv::Mat& bgr, const Grid& grid, float* sums, uint8_t* pe
   }
 }
 
-// Sum of B + G + R and the brightest channel value over a rectangle, every row.
-std::pair<double, uint8_t> MeasureRect(const cv::Mat& bgr, const cv::Rect& rect) {
-  uint64_t sum = 0;
-  uint8_t peak = 0;
-  const int bytes = rect.width * 3;
-  for (int y = rect.y; y < rect.y + rect.height; ++y) {
-    const uint8_t* pixel = bgr.ptr<uint8_t>(y) + rect.x * 3;
-    int u = 0;
-#if defined(__SSE2__)
-    const __m128i zero = _mm_setzero_si128();
-    __m128i sums = zero, peaks = zero;
-    for (; u + 16 <= bytes; u += 16) {
-      __m128i value;
-      std::memcpy(&value, pixel + u, sizeof value);
-      sums = _mm_add_epi64(sums, _mm_sad_epu8(value, zero));
-      peaks = _mm_max_epu8(peaks, value);
-    }
-    std::array<uint64_t, 2> halves{};
-    std::memcpy(halves.data(), &sums, sizeof halves);
-    std::array<uint8_t, 16> lanes{};
-    std::memcpy(lanes.data(), &peaks, sizeof lanes);
-    sum += halves[0] + halves[1];
-    peak = std::max(peak, *std::max_element(lanes.begin(), lanes.end()));
-#endif
-    for (; u < bytes; ++u) {
-      sum += pixel[u];
-      peak = std::max(peak, pixel[u]);
-    }
-  }
-  return {static_cast<double>(sum), peak};
-}
-
-// The instants consistent with what the frames around a step saw, ns.
-struct Interval {
-  double low_ns = 0.0, high_ns = 0.0;
-  int64_t Middle() const { return static_cast<int64_t>(std::llround(0.5 * (low_ns + high_ns))); }
-  int64_t HalfWidth() const {
-    return static_cast<int64_t>(std::llround(0.5 * std::max(0.0, high_ns - low_ns)));
-  }
-};
-
-// A switch-on seen first by frame `lit` (start t_lit, lit for the last fraction in
-// [f_low, f_high] of its exposure) after frame `dark` (start t_dark, lit for at most the
-// last dark_high of its exposure, which passes for noise). exposure_ns > 0: known; else
-// any exposure in (0, period_ns].
-Interval SwitchOnInterval(double t_dark, double t_lit, double f_low, double f_high,
-                          double dark_high, double exposure_ns, double period_ns) {
-  Interval interval;
-  if (exposure_ns > 0) {
-    interval.low_ns = t_lit + (1 - f_high) * exposure_ns;
-    interval.high_ns = t_lit + (1 - f_low) * exposure_ns;
-    // fully lit: on between (the end of) the dark frame's exposure and this one's start
-    if (f_high >= 1.0) interval.low_ns = std::min(t_dark + (1 - dark_high) * exposure_ns, t_lit);
-  } else {
-    interval.low_ns = f_high >= 1.0 ? t_dark : t_lit;
-    interval.high_ns = t_lit + (1 - f_low) * period_ns;
-  }
-  return interval;
-}
-
-// A switch-off seen last by frame `lit` (lit for the first fraction in [f_low, f_high] of
-// its exposure) before frame `dark` (lit for at most the first dark_high of its exposure).
-Interval SwitchOffInterval(double t_lit, double t_dark, double f_low, double f_high,
-                           double dark_high, double exposure_ns, double period_ns) {
-  Interval interval;
-  const double exposure_or_period_ns = exposure_ns > 0 ? exposure_ns : period_ns;
-  interval.low_ns = exposure_ns > 0 ? t_lit + f_low * exposure_ns : t_lit;
-  interval.high_ns = t_lit + f_high * exposure_or_period_ns;
-  // fully lit: off between this exposure's end and (early in) the dark frame's
-  if (f_high >= 1.0)
-    interval.high_ns = std::max(interval.high_ns, t_dark + dark_high * exposure_or_period_ns);
-  return interval;
-}
-
 enum class Level : uint8_t { kUnknown, kLow, kHigh };
 
 // One step a region made, with what is needed to date it: the frames around it.
 struct StepEvent {
   int region = 0;
   bool rise = true;
-  double step = 0.0;             // on - off, region sum
-  double off = 0.0, on = 0.0;    // region sum levels
-  double noise = 0.0;            // region sum noise
+  // the detection signal's levels, which confirmation watches
+  double signal_step = 0.0;
+  double signal_off = 0.0, signal_on = 0.0;
+  // the dating series (`value`, per frame of the window): linear in the LED's lit
+  // fraction; its levels off and on and its noise; clipped: the LED's pixels clip when
+  // lit, so a partly lit frame may look brighter than its fraction
+  double off = 0.0, on = 0.0;
+  double noise = 0.0;
+  bool clipped = false;
+  // how far the frames after the step went on in its direction, as a fraction of the step
+  // (the lit level may be higher still: a partly lit frame may have been less lit)
+  double creep = 0.0;
   double contrast_levels = 0.0;  // brightest channel step
+  double off_levels = 0.0, on_levels = 0.0;  // the region's mean, grey levels
   int64_t period_ns = 0;         // usual frame interval at the time
   std::vector<int64_t> index, t_ns;
   std::vector<double> value;
@@ -272,6 +296,7 @@ struct StepEvent {
   int frames_to_confirm = 0;
   int between = 0;
   Level level_before = Level::kUnknown;
+  float level_step_before = 0.0f;
 };
 
 }  // namespace
@@ -345,13 +370,30 @@ struct LedDetector::Impl {
   std::vector<float> cell_sums;     // ring x cells
   std::vector<uint8_t> cell_peaks;  // ring x cells
   std::vector<double> region_sums;  // ring x regions
-  std::vector<uint8_t> roi_peaks;   // ring (with an ROI)
+
+  // with an ROI: its last `ring` pictures (B, G, R), each pixel's reference brightness
+  // (B + G + R, following the frames that leave the ring, so a step is always measured
+  // against frames before it), how many of the largest changes the signal sums, scratch
+  std::vector<uint8_t> roi_pictures;  // ring x ROI pixels x 3
+  std::vector<float> pixel_reference;
+  int64_t reference_frames = 0;
+  size_t top_pixels = 0;
+  std::vector<float> changes;
+  std::vector<float> row_gains;  // ring x ROI rows
+  std::vector<float> row_ratios;
+  std::vector<float> band_gains;
+  std::vector<size_t> strip_columns;  // frame columns beside the ROI sampled for row gains
+  std::vector<float> strip_reference;  // ROI rows x strip columns
+  std::vector<float> strip_ring;       // ring x ROI rows x strip columns
+  std::vector<float> corrected;  // ROI pixels x ring
+  std::vector<double> pixel_steps, channel_steps, lit_peaks, pixel_wobble;
+  std::vector<double> dating_series;
 
   // per cell and region: the flicker reference, the usual frame-to-frame change, the level
   std::vector<float> cell_reference;
-  double roi_reference = 0.0;
   std::vector<float> region_noise;
   std::vector<Level> level;
+  std::vector<float> level_step;  // the step that set the level
 
   // the frame being measured (raw cell sums and peaks), scratch for medians and quantiles
   std::vector<float> raw_sums;
@@ -410,7 +452,28 @@ struct LedDetector::Impl {
       }
       grid = Grid::Make(width_px, height_px, options.cell_px, kReferenceStride);
       regions = 1;
-      pixels_per_region = static_cast<double>(roi.area());
+      const auto pixels = static_cast<size_t>(roi.area());
+      top_pixels = std::min(pixels, std::max(kTopPixelsMin, pixels / kTopPixelsShare));
+      pixels_per_region = static_cast<double>(top_pixels);
+      roi_pictures.assign(static_cast<size_t>(ring) * pixels * 3, 0);
+      pixel_reference.assign(pixels, 0.0f);
+      changes.assign(pixels, 0.0f);
+      corrected.assign(pixels * static_cast<size_t>(ring), 0.0f);
+      pixel_steps.assign(pixels, 0.0);
+      channel_steps.assign(pixels, 0.0);
+      lit_peaks.assign(pixels, 0.0);
+      pixel_wobble.assign(pixels, 0.0);
+      dating_series.assign(static_cast<size_t>(ring), 0.0);
+      row_gains.assign(static_cast<size_t>(ring) * static_cast<size_t>(roi.height), 1.0f);
+      for (int x = 0; x < width_px; x += kStripStepPx) {
+        if (x < roi.x - kStripStepPx || x >= roi.x + roi.width + kStripStepPx) {
+          strip_columns.push_back(static_cast<size_t>(x));
+        }
+      }
+      strip_reference.assign(strip_columns.size() * static_cast<size_t>(roi.height), 0.0f);
+      band_gains.assign(static_cast<size_t>(GainBands()), 1.0f);
+      strip_ring.assign(static_cast<size_t>(ring) * strip_reference.size(), 0.0f);
+      row_ratios.reserve(std::max(strip_columns.size() * static_cast<size_t>(kGainBandRows), static_cast<size_t>(roi.width)));
     }
     const auto slots = static_cast<size_t>(ring);
     ring_index.assign(slots, 0);
@@ -419,10 +482,10 @@ struct LedDetector::Impl {
     cell_sums.assign(slots * Cells(), 0.0f);
     region_sums.assign(slots * static_cast<size_t>(regions), 0.0);
     cell_peaks.assign(slots * Cells(), 0);
-    roi_peaks.assign(slots, 0);
     cell_reference.assign(Cells(), 0.0f);
     region_noise.assign(static_cast<size_t>(regions), 0.0f);
     level.assign(static_cast<size_t>(regions), Level::kUnknown);
+    level_step.assign(static_cast<size_t>(regions), 0.0f);
     events_per_region.assign(static_cast<size_t>(regions), 0);
     raw_sums.assign(Cells(), 0.0f);
     window_values.resize(static_cast<size_t>(ring));
@@ -469,11 +532,7 @@ struct LedDetector::Impl {
     }
     double* sums = &region_sums[slot * static_cast<size_t>(regions)];
     if (!located) {
-      const auto [sum, peak] = MeasureRect(frame.bgr, options.roi_px);
-      if (frames == 0) roi_reference = sum;
-      sums[0] = sum - (gain - 1.0) * roi_reference;
-      roi_peaks[slot] = peak;
-      roi_reference += (sum - roi_reference) * follow_rate;
+      sums[0] = MeasureRoi(frame.bgr, slot, gain);
       return;
     }
     // blocks of 2 x 2 cells
@@ -487,6 +546,221 @@ struct LedDetector::Impl {
         out[c] = static_cast<double>(top[c] + top[c + 1] + bottom[c] + bottom[c + 1]);
       }
     }
+  }
+
+  uint8_t* RoiPicture(size_t slot) {
+    return &roi_pictures[slot * static_cast<size_t>(options.roi_px.area()) * 3];
+  }
+
+  // with an ROI, the detection signal: the sum of the top_pixels largest increases of
+  // B + G + R over each pixel's reference (the scene's part scaled by the frame's gain),
+  // plus the top_pixels largest decreases (negative): a light switching on raises it,
+  // switching off lowers it, and however small the light, its pixels are among those
+  void FollowReference(const uint8_t* picture, const float* strip) {
+    ++reference_frames;
+    const auto rate = static_cast<float>(
+        1.0 / std::min(kReferenceFrames, static_cast<double>(reference_frames)));
+    for (size_t i = 0; i < pixel_reference.size(); ++i, picture += 3) {
+      const auto brightness = static_cast<float>(picture[0] + picture[1] + picture[2]);
+      pixel_reference[i] += rate * (brightness - pixel_reference[i]);
+    }
+    for (size_t i = 0; i < strip_reference.size(); ++i) {
+      strip_reference[i] += rate * (strip[i] - strip_reference[i]);
+    }
+  }
+
+  float* StripSamples(size_t slot) { return &strip_ring[slot * strip_reference.size()]; }
+
+  // the frame's rows beside the ROI (B + G + R every kStripStepPx px)
+  void SampleStrips(const cv::Mat& bgr, float* strip) const {
+    const size_t columns = strip_columns.size();
+    for (int y = 0; y < options.roi_px.height; ++y) {
+      const uint8_t* line = bgr.ptr<uint8_t>(options.roi_px.y + y);
+      float* out = strip + static_cast<size_t>(y) * columns;
+      for (size_t s = 0; s < columns; ++s) {
+        const uint8_t* pixel = line + 3 * strip_columns[s];
+        out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]);
+      }
+    }
+  }
+
+  float* RowGains(size_t slot) {
+    return &row_gains[slot * static_cast<size_t>(options.roi_px.height)];
+  }
+
+  // each row's gain: mains flicker seen by a rolling shutter bands the rows. The median
+  // ratio of the frame's row beside the ROI (every kStripStepPx px) to its reference, so
+  // the LED, however large in its ROI, never counts; the frame's gain where the row beside
+  // the ROI is too short or too dark. An ROI as wide as the frame uses its own row instead,
+  // leaving out pixels brighter than kRowRatioMax times the frame's gain (a lit light).
+  void MeasureRowGains(const uint8_t* picture, const float* strip, double gain, float* gains) {
+    const auto min_reference = static_cast<float>(3.0 * kGainMinLevels);
+    const size_t columns = strip_columns.size();
+    const auto width = static_cast<size_t>(options.roi_px.width);
+    const auto most = static_cast<float>(kRowRatioMax * gain);
+    for (int band = 0; band < GainBands(); ++band) {
+      const int y = BandRow(band);
+      const int band_end = std::min(options.roi_px.height, (band + 1) * kGainBandRows);
+      const auto band_rows = static_cast<size_t>(band_end - band * kGainBandRows);
+      const size_t samples = columns * band_rows;
+      row_ratios.clear();
+      if (columns >= kStripMinSamples) {
+        const size_t first = static_cast<size_t>(band * kGainBandRows) * columns;
+        const float* reference = &strip_reference[first];
+        const float* brightness = strip + first;
+        for (size_t s = 0; s < samples; ++s) {
+          if (reference[s] >= min_reference) row_ratios.push_back(brightness[s] / reference[s]);
+        }
+      } else {
+        const size_t first = static_cast<size_t>(y) * width;
+        for (size_t i = first; i < first + width; ++i) {
+          const uint8_t* pixel = picture + 3 * i;
+          if (pixel_reference[i] < min_reference) continue;
+          const float ratio = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / pixel_reference[i];
+          if (ratio < most) row_ratios.push_back(ratio);
+        }
+      }
+      const size_t needed = columns >= kStripMinSamples ? samples : width;
+      const float band_gain =
+          2 * row_ratios.size() > needed
+              ? MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size()))
+              : static_cast<float>(gain);
+      band_gains[static_cast<size_t>(band)] = band_gain;
+    }
+    // every row: linear between the measured rows around it
+    for (int y = 0; y < options.roi_px.height; ++y) {
+      const int band = std::clamp((y - kGainBandRows / 2) / kGainBandRows, 0, GainBands() - 1);
+      const int next = std::min(band + 1, GainBands() - 1);
+      const int from = BandRow(band), to = BandRow(next);
+      const float weight =
+          to > from ? std::clamp(static_cast<float>(y - from) / static_cast<float>(to - from), 0.0f, 1.0f)
+                    : 0.0f;
+      gains[y] = band_gains[static_cast<size_t>(band)] +
+                 weight * (band_gains[static_cast<size_t>(next)] - band_gains[static_cast<size_t>(band)]);
+    }
+  }
+
+  // the ROI's rows in bands of kGainBandRows (banding changes slowly from row to row), each
+  // measured on all its rows and taken for its middle row; rows between are interpolated
+  int GainBands() const { return (options.roi_px.height + kGainBandRows - 1) / kGainBandRows; }
+  int BandRow(int band) const {
+    return std::min(band * kGainBandRows + kGainBandRows / 2, options.roi_px.height - 1);
+  }
+
+  double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain) {
+    const cv::Rect& roi = options.roi_px;
+    uint8_t* picture = RoiPicture(slot);
+    float* strip = StripSamples(slot);
+    // the frame leaving the ring joins the references (the first frame starts them)
+    if (frames >= ring) FollowReference(picture, strip);
+    const auto row_bytes = static_cast<size_t>(roi.width) * 3;
+    for (int y = 0; y < roi.height; ++y) {
+      std::memcpy(picture + static_cast<size_t>(y) * row_bytes, bgr.ptr<uint8_t>(roi.y + y) + roi.x * 3,
+                  row_bytes);
+    }
+    SampleStrips(bgr, strip);
+    if (frames == 0) {
+      reference_frames = 0;
+      std::fill(pixel_reference.begin(), pixel_reference.end(), 0.0f);
+      std::fill(strip_reference.begin(), strip_reference.end(), 0.0f);
+      FollowReference(picture, strip);
+    }
+    float* gains = RowGains(slot);
+    MeasureRowGains(picture, strip, gain, gains);
+    const auto width = static_cast<size_t>(roi.width);
+    const uint8_t* pixel = picture;
+    for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
+      changes[i] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
+                   gains[i / width] * pixel_reference[i];
+    }
+    const auto top = static_cast<std::ptrdiff_t>(top_pixels);
+    std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end(), std::greater<>());
+    double signal = std::accumulate(changes.begin(), changes.begin() + top, 0.0);
+    std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end());
+    signal += std::accumulate(changes.begin(), changes.begin() + top, 0.0);
+    return signal;
+  }
+
+  // with an ROI: which pixels stepped at k, from the pictures around it. The dating series
+  // sums the pixels that brightened (rise) or darkened (fall) clearly, leaving out those
+  // that clip when lit unless they carry most of the step (then the event is marked
+  // clipped). False when the step does not look like a light: pixels stepping the other
+  // way by a good part of it (an edge moved by camera shake or a passing part).
+  bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
+    const size_t pixels = pixel_reference.size();
+    const auto frames_in_ring = static_cast<size_t>(ring);
+    const auto before = static_cast<size_t>(kBeforeFrames);
+    const auto width = static_cast<size_t>(options.roi_px.width);
+    std::vector<float> peaks(frames_in_ring);
+    double off_sum = 0.0, on_sum = 0.0;
+    for (size_t i = 0; i < pixels; ++i) {
+      float* values = &corrected[i * frames_in_ring];
+      for (size_t j = 0; j < frames_in_ring; ++j) {
+        const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
+        const uint8_t* pixel = RoiPicture(slot) + 3 * i;
+        values[j] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
+                    (RowGains(slot)[i / width] - 1.0f) * pixel_reference[i];
+        peaks[j] = static_cast<float>(std::max({pixel[0], pixel[1], pixel[2]}));
+      }
+      std::copy(values, values + frames_in_ring, window_sums.begin());
+      const double level_before = MedianOf(window_sums.data(), kBeforeFrames);
+      const double level_after =
+          MedianOf(window_sums.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+      const double peak_before = MedianOf(peaks.data(), kBeforeFrames);
+      const double peak_after =
+          MedianOf(peaks.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+      pixel_steps[i] = rise ? level_after - level_before : level_before - level_after;
+      channel_steps[i] = rise ? peak_after - peak_before : peak_before - peak_after;
+      lit_peaks[i] = rise ? peak_after : peak_before;
+      pixel_wobble[i] = std::abs(static_cast<double>(values[before - 1] - values[before - 2]));
+      off_sum += rise ? level_before : level_after;
+      on_sum += rise ? level_after : level_before;
+    }
+    // a pixel's noise (the median frame-to-frame change is 0.95 sigma for Gaussian noise)
+    const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
+    const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
+    const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
+    double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
+    for (size_t i = 0; i < pixels; ++i) {
+      if (pixel_steps[i] > clear) {
+        stepped += pixel_steps[i];
+        if (lit_peaks[i] < kClipLevels) unclipped += pixel_steps[i];
+      } else if (pixel_steps[i] < -clear) {
+        opposite -= pixel_steps[i];
+      }
+    }
+    if (stepped <= 0.0 || opposite > kRoiOppositeFrac * stepped) return false;
+    event.clipped = unclipped < kUnclippedShare * stepped;
+    // the dating dating_series and the LED's contrast over the chosen pixels
+    std::fill(dating_series.begin(), dating_series.end(), 0.0);
+    std::vector<double> contrasts;
+    for (size_t i = 0; i < pixels; ++i) {
+      if (!(pixel_steps[i] > clear)) continue;
+      contrasts.push_back(channel_steps[i]);
+      if (!event.clipped && lit_peaks[i] >= kClipLevels) continue;
+      const float* values = &corrected[i * frames_in_ring];
+      for (size_t j = 0; j < frames_in_ring; ++j) dating_series[j] += static_cast<double>(values[j]);
+    }
+    std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
+    event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
+    // the levels: the medians of the frames before and after (the pixels of a small light
+    // may still be catching up after it: the creep widens the partly lit frame's band)
+    const WindowShape shape = ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
+                                      options.threshold_frac, window_copy);
+    if (!(shape.step > 0)) return false;
+    const double widest = std::max(shape.before_spread, shape.after_against);
+    if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {
+      return false;
+    }
+    event.off = rise ? shape.before_level : shape.after_level;
+    event.on = rise ? shape.after_level : shape.before_level;
+    if (!(event.on > event.off)) return false;
+    event.noise = 0.5 * widest;
+    event.creep = shape.after_creep / (event.on - event.off);
+    event.value = dating_series;
+    event.off_levels = off_sum / (3.0 * static_cast<double>(pixels));
+    event.on_levels = on_sum / (3.0 * static_cast<double>(pixels));
+    return true;
   }
 
   int64_t PeriodNs() const {
@@ -553,8 +827,11 @@ struct LedDetector::Impl {
       const double needed = std::max(min_step, kNoiseFactor * static_cast<double>(region_noise[r]));
       region_noise[r] +=
           follow * (static_cast<float>(std::abs(previous[r] - earlier[r])) - region_noise[r]);
-      const bool rise = jump > needed && level[r] != Level::kHigh;
-      const bool fall = jump < -needed && level[r] != Level::kLow;
+      // a region at a level steps only the other way, unless by far more than the step
+      // that set the level (a faint step before the LED's must not hide it)
+      const bool stronger = std::abs(jump) > kStrongerFactor * static_cast<double>(level_step[r]);
+      const bool rise = jump > needed && (level[r] != Level::kHigh || stronger);
+      const bool fall = jump < -needed && (level[r] != Level::kLow || stronger);
       if (rise || fall) {
         TestStep(region, k, rise, min_step, std::abs(jump), outlier_jump, outlier_contrast);
       }
@@ -574,14 +851,10 @@ struct LedDetector::Impl {
     return rise ? after - before : before - after;
   }
 
-  // the LED's own contrast, grey levels: the step of the brightest channel, or of the mean
-  // where that is larger (a brighter object beside the LED hides its brightest pixel);
-  // when locating, of the block's best cell
-  double Contrast(int region, int64_t k, bool rise, double step) {
-    if (!located) {
-      const double peak_step = WindowStep(roi_peaks, 1, 0, k, rise, window_peaks);
-      return std::max(peak_step, step / (3.0 * pixels_per_region));
-    }
+  // located: the LED's own contrast, grey levels: the step of the brightest channel of the
+  // block's best cell, or of its mean where that is larger (a brighter object beside the
+  // LED hides its brightest pixel)
+  double Contrast(int region, int64_t k, bool rise) {
     const int column = region % block_columns, row = region / block_columns;
     double contrast = 0.0;
     for (int dy = 0; dy < 2; ++dy) {
@@ -611,15 +884,17 @@ struct LedDetector::Impl {
     const auto after_end = window_values.cend();
     const auto [before_low, before_high] = std::minmax_element(before, before_end);
     const auto [after_low, after_high] = std::minmax_element(after, after_end);
-    const double before_spread = *before_high - *before_low;
-    const double after_spread = *after_high - *after_low;
-    std::copy(window_values.begin(), window_values.end(), window_copy.begin());
-    const double before_level = MedianOf(window_copy.data(), kBeforeFrames);
-    const double after_level = MedianOf(window_copy.data() + kBeforeFrames + 1, after_frames);
-    const double step = rise ? after_level - before_level : before_level - after_level;
+    const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, after_frames, rise,
+                                      options.threshold_frac, window_copy);
+    const double before_level = shape.before_level, after_level = shape.after_level;
+    const double step = shape.step;
+    const double before_spread = shape.before_spread;
     if (step < min_step) return;
     const double flat = FlatFrac();
-    if (before_spread > flat * step || after_spread > flat * step) return;
+    if (before_spread > flat * step || shape.after_against > flat * step ||
+        shape.after_creep > kCreepFrac * step) {
+      return;
+    }
     // a partly lit frame just after k is the next frame's transition: wait for it
     if (std::abs(*after - after_level) > 0.5 * flat * step) return;
     const double off = rise ? before_level : after_level;
@@ -631,7 +906,9 @@ struct LedDetector::Impl {
     if (outlier_jump < 0) outlier_jump = OutlierJump(k);
     if (jump < outlier_jump) return;
 
-    const double contrast = Contrast(region, k, rise, step);
+    StepEvent event;
+    if (!located && !MeasureRoiStep(k, rise, event)) return;
+    const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
     if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
     if (contrast < outlier_contrast) return;
     if (contrast < options.min_contrast_levels) {
@@ -643,27 +920,35 @@ struct LedDetector::Impl {
     }
     if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
 
-    StepEvent event;
     event.region = region;
     event.rise = rise;
-    event.step = step;
-    event.off = off;
-    event.on = off + step;
-    event.noise = 0.5 * std::max(before_spread, after_spread);
+    event.signal_step = step;
+    event.signal_off = off;
+    event.signal_on = off + step;
     event.contrast_levels = contrast;
     event.period_ns = PeriodNs();
     for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
       event.index.push_back(ring_index[Slot(frame)]);
       event.t_ns.push_back(ring_t_ns[Slot(frame)]);
-      event.value.push_back(region_sums[at(frame)]);
     }
     if (located) {
+      // the block's own sums date the step
+      event.off = off;
+      event.on = off + step;
+      event.noise = 0.5 * std::max({before_spread, shape.after_against, shape.after_creep});
+      event.off_levels = event.off / (3.0 * pixels_per_region);
+      event.on_levels = event.on / (3.0 * pixels_per_region);
+      for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
+        event.value.push_back(region_sums[at(frame)]);
+      }
       RecordCellSteps(event, k);
       if (!LooksLikeALight(event)) return;
     }
     event.frames_to_confirm = kConfirmFrames;
     event.level_before = level[static_cast<size_t>(region)];
+    event.level_step_before = level_step[static_cast<size_t>(region)];
     level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
+    level_step[static_cast<size_t>(region)] = static_cast<float>(step);
     ++events_per_region[static_cast<size_t>(region)];
     pending.push_back(std::move(event));
   }
@@ -692,14 +977,18 @@ struct LedDetector::Impl {
     for (StepEvent& event : pending) {
       const double value =
           region_sums[slot * static_cast<size_t>(regions) + static_cast<size_t>(event.region)];
-      const double tolerance = FlatFrac() * event.step;
-      const double held = event.rise ? event.on : event.off;
-      const double left = event.rise ? event.off : event.on;
+      const double tolerance = FlatFrac() * event.signal_step;
+      const double held = event.rise ? event.signal_on : event.signal_off;
+      const double left = event.rise ? event.signal_off : event.signal_on;
+      const double beyond = (event.rise ? 1.0 : -1.0) * (value - held);
+      const bool holds = std::abs(value - held) <= tolerance ||
+                         (beyond > 0 && beyond <= kCreepFrac * event.signal_step);
       bool done = false;
       if (std::abs(value - left) <= tolerance) {
         done = true;  // back already: a short pulse
-      } else if (std::abs(value - held) > tolerance && ++event.between > 1) {
+      } else if (!holds && ++event.between > 1) {
         level[static_cast<size_t>(event.region)] = event.level_before;
+        level_step[static_cast<size_t>(event.region)] = event.level_step_before;
         --events_per_region[static_cast<size_t>(event.region)];
         continue;
       }
@@ -778,14 +1067,27 @@ struct LedDetector::Impl {
   }
 
   // the instant of one step, from its frames
+  // A frame partly lit by a switch-on is followed by a fully lit one (an exposure of at most
+  // the frame interval cannot be partly lit twice), so the frame before a partly lit one is
+  // not taken for the partly lit frame, however much light a codec lent it.
   LedPulse DatePulse(const StepEvent& event) const {
-    const double exposure_ns = static_cast<double>(NsFromSeconds(options.exposure_s));
-    const auto period_ns = static_cast<double>(event.period_ns);
+    const auto exposure_ns = static_cast<double>(NsFromSeconds(options.exposure_s));
+    const ExposureRange exposure =
+        exposure_ns > 0 ? ExposureRange{exposure_ns, exposure_ns}
+                        : ExposureRange{0.0, static_cast<double>(event.period_ns)};
     const double scale = event.on - event.off;
     const double noise_fraction = event.noise / scale;
     const double band = std::max(kFractionSigmas * noise_fraction, kFractionMargin);
     const double lit_above = std::max(kFractionSigmas * noise_fraction, kLitFraction);
     const auto fraction = [&](size_t i) { return (event.value[i] - event.off) / scale; };
+    // what the partly lit frame saw: its fraction within the noise band; when the LED's
+    // pixels clip, a partly lit frame looks brighter than it was, so only the upper bound
+    // holds
+    const auto lit_band = [&](double f) {
+      return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - band - event.creep),
+                         std::min(1.0, f + band)};
+    };
+    const LitFraction dark{0.0, lit_above};
     const size_t count = event.value.size();
     LedPulse pulse;
     if (event.rise) {
@@ -798,11 +1100,11 @@ struct LedDetector::Impl {
           break;
         }
       }
-      if (lit >= 2 && fraction(lit - 1) > lit_above) --lit;
+      if (lit >= 2 && fraction(lit - 1) > lit_above && fraction(lit) >= 1.0 - band) --lit;
       const double f = std::clamp(fraction(lit), 0.0, 1.0);
-      const Interval interval = SwitchOnInterval(
-          static_cast<double>(event.t_ns[lit - 1]), static_cast<double>(event.t_ns[lit]),
-          std::max(0.0, f - band), std::min(1.0, f + band), lit_above, exposure_ns, period_ns);
+      const InstantInterval interval =
+          internal::SwitchOnInterval(static_cast<double>(event.t_ns[lit - 1]), dark,
+                                     static_cast<double>(event.t_ns[lit]), lit_band(f), exposure);
       pulse.on_ns = interval.Middle();
       pulse.on_uncertainty_ns = interval.HalfWidth();
       pulse.first_lit_frame = event.index[lit];
@@ -817,11 +1119,11 @@ struct LedDetector::Impl {
           break;
         }
       }
-      if (lit + 2 < count && fraction(lit + 1) > lit_above) ++lit;
+      if (lit + 2 < count && fraction(lit + 1) > lit_above && fraction(lit) >= 1.0 - band) ++lit;
       const double f = std::clamp(fraction(lit), 0.0, 1.0);
-      const Interval interval = SwitchOffInterval(
-          static_cast<double>(event.t_ns[lit]), static_cast<double>(event.t_ns[lit + 1]),
-          std::max(0.0, f - band), std::min(1.0, f + band), lit_above, exposure_ns, period_ns);
+      const InstantInterval interval =
+          internal::SwitchOffInterval(static_cast<double>(event.t_ns[lit]), lit_band(f),
+                                      static_cast<double>(event.t_ns[lit + 1]), dark, exposure);
       pulse.off_ns = interval.Middle();
       pulse.off_uncertainty_ns = interval.HalfWidth();
     }
@@ -865,8 +1167,8 @@ struct LedDetector::Impl {
     double best_step = 0.0;
     for (const StepEvent* event : steps) {
       if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
-          event->step > best_step) {
-        best_step = event->step;
+          event->signal_step > best_step) {
+        best_step = event->signal_step;
         best = event->region;
       }
     }
@@ -906,13 +1208,23 @@ struct LedDetector::Impl {
       return NotFoundError(message);
     }
 
+    // the LED's own steps: every pulse of one LED has about the same contrast, so the
+    // region's fainter steps are something else (a shadow, a shifted edge)
+    double best_contrast = 0.0;
+    for (const StepEvent* event : steps) {
+      if (event->region == best && event->rise) {
+        best_contrast = std::max(best_contrast, event->contrast_levels);
+      }
+    }
     LedResult result;
     result.roi_located = located;
     bool first_rise_seen = false;
     bool already_on = false;
     for (const StepEvent* step : steps) {
       const StepEvent& event = *step;
-      if (event.region != best) continue;
+      if (event.region != best || event.contrast_levels < kEligibleContrastFrac * best_contrast) {
+        continue;
+      }
       if (!event.rise) {
         if (!first_rise_seen) already_on = true;
         if (!result.pulses.empty() && !result.pulses.back().off_ns) {
@@ -924,8 +1236,8 @@ struct LedDetector::Impl {
       }
       if (!first_rise_seen) {
         first_rise_seen = true;
-        result.off_level = event.off / (3.0 * pixels_per_region);
-        result.on_level = event.on / (3.0 * pixels_per_region);
+        result.off_level = event.off_levels;
+        result.on_level = event.on_levels;
         result.contrast_levels = event.contrast_levels;
         result.roi_px = located ? LocatedRect(event) : options.roi_px;
       }

@@ -167,13 +167,14 @@ TEST(SceneRenderer, ShakeIsABoundedWalkAndNoiseHasTheAskedSigma) {
 // ---------------------------------------------------------------------------------------
 // the LED
 
-// fps 60, exposure 1/120 s = 8333333 ns; frame 60 exposes [1 s, 1.008333333 s).
+// fps 60, exposure 1/120 s = 8333333 ns, centred on the frame's timestamp: frame 60 (1 s)
+// exposes [995833334, 1004166667) ns.
 TEST(SceneRenderer, LedRegionBrightensByTheExposureFractionInThePartialFrame) {
   TrialSpec spec = SmallSpec();
-  spec.led.on_video_s = 1.003;  // 3 ms into frame 60's exposure
+  spec.led.on_video_s = 1.003 - 1.0 / 240;  // 998833333 ns: 3 ms into frame 60's exposure
   Rendered scene = Make(spec);
-  // by hand: on for 8333333 - 3000000 ns of 8333333 ns
-  const double fraction = (8333333.0 - 3000000.0) / 8333333.0;  // 0.64
+  // by hand: on for 1004166667 - 998833333 ns of 8333333 ns
+  const double fraction = (1004166667.0 - 998833333.0) / 8333333.0;  // 0.64
   EXPECT_NEAR(scene.renderer.LedOnFraction(FrameNs(60)), fraction, 1e-9);
   EXPECT_EQ(scene.renderer.LedOnFraction(FrameNs(59)), 0.0);
   EXPECT_EQ(scene.renderer.LedOnFraction(FrameNs(61)), 1.0);
@@ -192,7 +193,7 @@ TEST(SceneRenderer, LedRegionBrightensByTheExposureFractionInThePartialFrame) {
 
 TEST(SceneRenderer, LedSwitchingOnBetweenExposuresGivesNoPartialFrame) {
   TrialSpec spec = SmallSpec();
-  spec.led.on_video_s = 1.012;  // after frame 60's exposure ends (1.00833 s), before 61
+  spec.led.on_video_s = 1.012;  // after frame 60's exposure ends (1.00417 s), before 61's (1.0125)
   Rendered scene = Make(spec);
   const cv::Rect roi = Rect(scene.renderer.led_roi_px());
   const double off = MeanGrey(scene.renderer.RenderFrame(55, FrameNs(55)), roi);
@@ -204,7 +205,7 @@ TEST(SceneRenderer, LedSwitchingOnBetweenExposuresGivesNoPartialFrame) {
 
 TEST(SceneRenderer, LedStepIsFoundAtTheTrueFrameUnderNoiseFlickerAndShake) {
   TrialSpec spec = WithNuisances(SmallSpec());
-  spec.led.on_video_s = 1.002;  // frame 60 sees it for (8.333 - 2) / 8.333 = 76 %
+  spec.led.on_video_s = 1.002 - 1.0 / 240;  // 2 ms into frame 60's exposure: lit 76 %
   Rendered scene = Make(spec);
   const cv::Rect roi = Rect(scene.renderer.led_roi_px());
   std::vector<double> mean;
@@ -375,7 +376,7 @@ TEST(SceneRenderer, FootBottomEdgeFollowsTheTrueHeightCurve) {
 
 TEST(SceneRenderer, MotionBlurAveragesTheFootOverTheExposure) {
   // a long exposure while the foot rises fast: the tape's centroid shift is the mean of
-  // the lift over the exposure, not the lift at its start
+  // the lift over the exposure, not the lift at its start (or its middle)
   TrialSpec spec = SmallSpec();
   spec.camera.exposure_s = 1.0 / 60;
   spec.nuisance.motion_blur_samples = 16;
@@ -386,7 +387,9 @@ TEST(SceneRenderer, MotionBlurAveragesTheFootOverTheExposure) {
   const int tape_begin = static_cast<int>(place.tape_top_px) - 30;
   const int tape_end = static_cast<int>(place.tape_bottom_px) + 3;
   const int64_t start_ns = *scene.timeline.FirstVideoNsAbove(0.005);
-  const cv::Mat frame = scene.renderer.RenderFrame(0, start_ns);
+  // the frame whose exposure (centred on its timestamp) starts when the foot is 5 mm up
+  const int64_t t_ns = start_ns - ExposureStartNs(spec.camera, 0);
+  const cv::Mat frame = scene.renderer.RenderFrame(0, t_ns);
   const cv::Mat at_rest = scene.renderer.RenderFrame(0, 0);
   // the mean lift over the exposure, analytically: height = gain * u^1.5 with u the
   // rotation past liftoff, rising at the ramp rate from u0 (5 mm) by rate * exposure, so
@@ -438,8 +441,9 @@ TEST(SceneRenderer, DiagonalPartnerRisesWhenLagged) {
 }
 
 TEST(SceneRenderer, FlickerScalesTheSceneByTheLampsMeanOverTheExposure) {
-  // 100 Hz flicker of amplitude 0.2, exposure 1/200 s: half a period. By hand, the mean of
-  // sin over the first half period is 2/pi, over the second -2/pi; over a whole period 0.
+  // 100 Hz flicker of amplitude 0.2, exposure 1/200 s: half a period, centred on the
+  // frame's timestamp. By hand, the mean of sin over the first half period is 2/pi, over
+  // the second -2/pi; over a whole period 0.
   TrialSpec steady = SmallSpec();
   steady.camera.fps = 30;
   steady.camera.exposure_s = 1.0 / 200;
@@ -453,9 +457,9 @@ TEST(SceneRenderer, FlickerScalesTheSceneByTheLampsMeanOverTheExposure) {
     return cv::mean(lit.renderer.RenderFrame(0, t_ns)(bed))[0] /
            cv::mean(plain.renderer.RenderFrame(0, t_ns)(bed))[0];
   };
-  EXPECT_NEAR(ratio(0), 1 + 0.2 * 2 / std::numbers::pi, 0.005);
-  EXPECT_NEAR(ratio(5'000'000), 1 - 0.2 * 2 / std::numbers::pi, 0.005);
-  EXPECT_NEAR(ratio(2'500'000), 1.0, 0.005);  // a quarter period on: symmetric about the peak
+  EXPECT_NEAR(ratio(2'500'000), 1 + 0.2 * 2 / std::numbers::pi, 0.005);  // [0, 5) ms
+  EXPECT_NEAR(ratio(7'500'000), 1 - 0.2 * 2 / std::numbers::pi, 0.005);  // [5, 10) ms
+  EXPECT_NEAR(ratio(5'000'000), 1.0, 0.005);  // [2.5, 7.5) ms: about the zero crossing
   // the LED is self-lit: flicker does not dim it
   const cv::Rect led = Rect(lit.renderer.led_roi_px());
   const cv::Point centre(led.x + led.width / 2, led.y + led.height / 2);
@@ -502,7 +506,7 @@ TEST(SceneRenderer, DISABLED_WriteDocFrames) {
   base.camera.width_px = 960;
   base.camera.height_px = 540;
   base.nuisance.shadow = true;
-  base.led.on_video_s = 1.003;
+  base.led.on_video_s = 1.003 - 1.0 / 240;  // 3 ms into frame 60's exposure
 
   {  // default nuisances, LED off, feet at rest
     Rendered scene = Make(base);

@@ -123,11 +123,13 @@ TEST(LedTruth, SwitchOnInsideAnExposureGivesThePartialFraction) {
   TrialSpec spec = SmallSpec();
   spec.camera.fps = 100.0;
   spec.camera.exposure_s = 0.005;
-  spec.led.on_video_s = 0.012;  // frame 1 exposes [10, 15) ms: on for 3 of its 5 ms
+  // frame 1 (timestamp 10 ms, the middle of its exposure) exposes [7.5, 12.5) ms: on for
+  // 3 of its 5 ms
+  spec.led.on_video_s = 0.0095;
   GroundTruth truth;
   FillLedTruth(spec, {0, 10'000'000, 20'000'000, 30'000'000}, truth);
   ASSERT_TRUE(truth.led_on_video_ns && truth.led_first_frame);
-  EXPECT_EQ(*truth.led_on_video_ns, 12'000'000);
+  EXPECT_EQ(*truth.led_on_video_ns, 9'500'000);
   EXPECT_EQ(*truth.led_first_frame, 1);
   EXPECT_NEAR(truth.led_first_frame_fraction, 0.6, 1e-12);
 }
@@ -136,7 +138,7 @@ TEST(LedTruth, SwitchOnBetweenExposuresGivesAWholeFrame) {
   TrialSpec spec = SmallSpec();
   spec.camera.fps = 100.0;
   spec.camera.exposure_s = 0.005;
-  spec.led.on_video_s = 0.016;  // after frame 1's exposure ended at 15 ms
+  spec.led.on_video_s = 0.016;  // after frame 1's exposure ended at 12.5 ms, before 2's at 17.5
   GroundTruth truth;
   FillLedTruth(spec, {0, 10'000'000, 20'000'000, 30'000'000}, truth);
   ASSERT_TRUE(truth.led_first_frame);
@@ -298,10 +300,11 @@ TEST(WriteTrial, TruthHoldsTheHandComputedLiftoff) {
   EXPECT_NEAR(static_cast<double>(*truth.liftoff_0mm_video_ns), 1.2e9, 2.0);
   EXPECT_NEAR(static_cast<double>(*truth.liftoff_1mm_video_ns), (0.4 + one_mm_rad / 0.5) * 1e9,
               2.0);
-  // LED at 0.3 s = frame 9's start at 30 fps: a whole frame
+  // LED at 0.3 s = frame 9's timestamp at 30 fps, the middle of its 1/60 s exposure
+  // [291666667, 308333334) ns: lit for 8333334 of its 16666667 ns
   EXPECT_EQ(truth.led_on_video_ns, 300'000'000);
   EXPECT_EQ(truth.led_first_frame, 9);
-  EXPECT_EQ(truth.led_first_frame_fraction, 1.0);
+  EXPECT_NEAR(truth.led_first_frame_fraction, 8333334.0 / 16666667.0, 1e-12);
   EXPECT_GT(truth.px_per_mm, 0.0);
   EXPECT_GT(truth.led_roi_px.width_px, 0);
   EXPECT_GT(truth.foot_roi_px.height_px, 0);
@@ -426,10 +429,11 @@ TEST(CiSet, EveryNuisanceAndOptionIsExercisedAtLeastOnce) {
   EXPECT_TRUE(any([](S s) { return s.camera.exposure_s * s.camera.fps > 0.99; }));
   EXPECT_TRUE(any([](S s) { return s.camera.exposure_s * s.camera.fps < 0.25; }));
   EXPECT_TRUE(any([](S s) {
+    // exposures are centred on the frames' timestamps (whole slots)
     const double slots = s.led.on_video_s * s.camera.fps;
-    const double into_frame = slots - std::floor(slots);
+    const double from_timestamp = std::abs(slots - std::round(slots));
     return s.camera.drop_probability == 0 && s.camera.timestamp_jitter_s == 0 &&
-           into_frame > 0.01 && into_frame < s.camera.exposure_s * s.camera.fps - 0.01;
+           from_timestamp < 0.5 * s.camera.exposure_s * s.camera.fps - 0.01;
   }));
   // image nuisances
   EXPECT_TRUE(any([](S s) { return s.nuisance.noise_sigma > 0; }));

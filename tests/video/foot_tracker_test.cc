@@ -47,6 +47,12 @@ struct Scene {
   int64_t exposure_ns = 0;
   int64_t frame_ns = 0;
 
+  // The frame whose exposure starts at start_ns. These tests stamp frames with the start
+  // of their exposure, the convention the tracker dates by (t + E/2); the renderer centres
+  // the exposure on the time it is given.
+  cv::Mat RenderStartingAt(int64_t index, int64_t start_ns) {
+    return renderer.RenderFrame(index, start_ns + exposure_ns / 2);
+  }
   // The truth a frame starting at t_ns shows: the foot's rise at mid-exposure, px.
   double TrueRisePx(int64_t t_ns) const {
     return renderer.foot_rest_bottom_px() - renderer.FootBottomPxAt(t_ns + exposure_ns / 2);
@@ -87,7 +93,7 @@ Result<FootTrack> TrackClip(Scene& scene, const FootTracker::Options& options,
     Frame frame;
     frame.index = k;
     frame.t_ns = k * scene.frame_ns;
-    frame.bgr = scene.renderer.RenderFrame(k, frame.t_ns);
+    frame.bgr = scene.RenderStartingAt(k, frame.t_ns);
     if (edit) edit(frame.bgr);
     const Status status = tracker.Process(frame);
     if (!status.ok()) return status;
@@ -133,7 +139,7 @@ TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
     }
     times_ns.push_back(t_ns);
     Frame frame{static_cast<int64_t>(i), t_ns, false,
-                scene.renderer.RenderFrame(static_cast<int64_t>(i), t_ns)};
+                scene.RenderStartingAt(static_cast<int64_t>(i), t_ns)};
     ASSERT_TRUE(tracker.Process(frame).ok());
   }
   Result<FootTrack> track = tracker.Finish();

@@ -29,7 +29,7 @@
 //      linear row interpolation (exact area coverage for the horizontal bottom edge),
 //      over the bed darkened by the foot's soft shadow, averaged over
 //      nuisance.motion_blur_samples sub-samples at the midpoints of the exposure's
-//      equal parts;
+//      equal parts (the exposure is centred on the frame's timestamp: ExposureStartNs);
 //   3. flicker: the scene is scaled by the lamp's brightness averaged analytically over
 //      the exposure, 1 + a * sin(2 pi f t);
 //   4. the LED, self-lit (no flicker): the frame's "on" picture (disc of colour *
@@ -78,7 +78,7 @@ class SceneRenderer {
   /// not validate; OpenCV failures come back as kInvalidArgument too.
   static Result<SceneRenderer> Create(const Timeline& timeline);
 
-  /// The frame whose exposure starts at `t_video_ns` (video clock), BGR 8-bit,
+  /// The frame with timestamp `t_video_ns` (video clock; the middle of its exposure), BGR 8-bit,
   /// camera.width_px x camera.height_px. `frame_index` seeds the shake and the noise.
   cv::Mat RenderFrame(int64_t frame_index, int64_t t_video_ns);
 
@@ -96,8 +96,8 @@ class SceneRenderer {
   /// Row of the lifting foot's bottom edge at a video instant, at zero shake:
   /// foot_rest_bottom_px() - height_mm * px_per_mm() (the truth tests compare against).
   double FootBottomPxAt(int64_t t_video_ns) const;
-  /// Fraction of the exposure [t_video_ns, t_video_ns + exposure) during which the LED
-  /// is on, 0 .. 1 (Timeline::LedOnFractionOfExposure, as the truth counts it).
+  /// Fraction of the exposure of the frame with timestamp t_video_ns (centred on it)
+  /// during which the LED is on, 0 .. 1 (Timeline::LedOnFractionOfExposure, as the truth counts it).
   double LedOnFraction(int64_t t_video_ns) const;
   /// Camera shake of frame `frame_index`: the picture's translation, px (x right,
   /// y down); 0 without shake.

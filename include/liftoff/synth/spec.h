@@ -2,7 +2,8 @@
 // nuisances, robot motion, controller log) and the exact ground truth it implies.
 //
 // Three clocks, all int64 ns:
-//   video clock   t_video_ns   from the first frame's exposure start (frame 0 at ~0)
+//   video clock   t_video_ns   frame timestamps (frame 0 at ~0); a frame's timestamp is the
+//                              middle of its exposure
 //   device clock  t_device_ns  the controller's; the LED switches on at led_on_device_ns
 //   test clock    seconds since the LED switched on (the test's own timeline, `_s`)
 // device_from_video maps the video's LED-on instant to the log's, with optional drift.
@@ -43,8 +44,9 @@ struct CameraSpec {
   int width_px = 1280;  ///< 320 .. 1920, even (4:2:0 chroma)
   int height_px = 720;  ///< 240 .. 1080, even
   double fps = 60.0;    ///< nominal frame rate: 30, 60, 120 or 240 (any in 1 .. 1000)
-  /// Exposure time per frame, s (0 < exposure <= 1/fps). A frame integrates the scene
-  /// over [t_frame, t_frame + exposure): an LED switching on mid-exposure gives a
+  /// Exposure time per frame, s (0 < exposure <= 1/fps). A frame with timestamp t_frame
+  /// integrates the scene over [t_frame - exposure / 2, t_frame + exposure / 2) (the
+  /// timestamp is the middle of the exposure): an LED switching on mid-exposure gives a
   /// partial-brightness frame.
   double exposure_s = 1.0 / 120.0;
   /// Variable frame rate: probability that a frame is dropped (its slot is skipped, so
@@ -236,10 +238,15 @@ Result<GroundTruth> GroundTruthFromJson(const nlohmann::json& document, const st
 
 /// Exposure time per frame, ns (at least 1).
 int64_t ExposureNs(const CameraSpec& camera);
+/// Start of the exposure of the frame with timestamp t_frame_ns, ns: t_frame_ns -
+/// ExposureNs / 2 (the timestamp is the middle of the exposure; the exposure is
+/// [start, start + ExposureNs)).
+int64_t ExposureStartNs(const CameraSpec& camera, int64_t t_frame_ns);
 /// The LED switch-on, video clock; nullopt when the LED never switches on within the clip
 /// (led.on_video_s outside [0, duration_s)).
 std::optional<int64_t> LedOnVideoNs(const TrialSpec& spec);
-/// Fraction of the exposure [t_frame_ns, t_frame_ns + exposure) during which the LED is
+/// Fraction of the exposure of the frame with timestamp t_frame_ns (centred on it: see
+/// ExposureStartNs) during which the LED is
 /// on, 0 .. 1: what the renderer draws and what the truth reports for the first lit frame.
 double LedOnFractionOfExposure(const TrialSpec& spec, int64_t t_frame_ns);
 

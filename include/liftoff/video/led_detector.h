@@ -2,41 +2,53 @@
 // the largest sustained brightness step) and every instant it switches on, with
 // sub-frame precision where a frame caught the switch-on mid-exposure.
 //
-// The brightness of the LED region in a frame whose exposure [t, t + E) saw the LED on
-// for the last fraction f of it is off + f (on - off): every pixel integrates the light,
-// so the region's sum is linear in f, also where the lit LED clips at 255 (the on level
-// is then the clipped one). The detector measures f against the levels of the frames
-// before and after the step, so the switch-on instant is t + (1 - f) E. When the LED
-// switched on between two exposures (f = 1), it lies between the previous exposure's end
-// and this frame's start. E (the exposure) is rarely known: by default it is only bounded
-// by the camera's frame interval T, and the estimate is the middle of every instant
-// consistent with some exposure in (0, T] (t + (1 - f) T / 2 for a partial frame, the
-// middle of the two frames' starts for a full one), which bounds the error by half a
-// frame interval. With Options::exposure_s the partial-frame estimate is exact up to the
-// noise of f. Each instant comes with the half-width of that interval as its uncertainty.
+// Exposure convention: a frame's timestamp t is the middle of its exposure [t - E/2,
+// t + E/2]. A frame that saw the LED on for the fraction f of its exposure is f of the way
+// from the off to the on level in every pixel that does not clip (pixels integrate light).
+// The switch-on lies in the union, over every exposure allowed, of the instants consistent
+// with the last dark frame and the first lit one, on their real timestamps (a dropped frame
+// there widens it); the estimate is its middle and its half-width the uncertainty. E is
+// rarely known: by default any exposure in (0, T] (T the usual frame interval), so a partly
+// lit frame dates the switch-on to t + (1/2 - f) E for some such E (error at most T / 4), and
+// a switch-on between exposures to the middle of the two frames' timestamps (T / 2 without
+// drops). With Options::exposure_s a partly lit frame dates it to within the noise of f.
+// A partly lit frame is always followed by a fully lit one (E <= T), which tells it from
+// the light a codec's B-frame lends the frame before. Switch-offs: the same, time reversed.
 //
-// Regions: with an ROI, the whole ROI is measured (it should hold the LED, its glow and a
-// margin for camera shake). Without one, the frame is cut into cells of cell_px (every
-// other row sampled) and every 2 x 2 block of cells is a candidate region; each keeps a
-// few frames of its brightness and a fixed-size record per step it made, never pixels.
-// The measure is the sum of B, G and R: the LED must brighten its region, not only change
-// its hue.
+// With an ROI the detector works on the ROI's pixels, so a 1 px LED in a region hundreds of
+// times its size is found: each pixel's B + G + R against its own reference (an average of
+// the frames that left a ring of the last 5 + min_on_frames, so a step is measured against frames before
+// it), each row's flicker gain taken out first (measured on the same rows beside the ROI, in
+// bands of 4 rows, interpolated: rolling-shutter banding). The signal is the sum of the largest increases (a 256th of the
+// ROI's pixels, at least 9) plus the largest decreases. Around a step the ROI's pixels that
+// stepped clearly are the LED's: no light when pixels stepping the other way add up to half
+// as much (an edge moved by shake or a passing part) or when they do not hold their levels;
+// the dating sums those that do not clip when lit (all of them, marked clipped, when those
+// carry less than a quarter of the step: then only the upper bound of f holds, as a clipped
+// core reaches 255 even in a partly lit frame). The fraction is known to within 3 sigmas of
+// the frame-to-frame noise (at least 0.08), widened downwards when the levels creep on after
+// the step (a codec refining a small spot). contrast_levels is the brightest-channel step of
+// the LED's third-brightest pixel.
 //
-// A step counts when the region's brightness jumps and holds: the 4 frames before it and
-// the min_on_frames after it are flat compared with the step, it crosses threshold_frac of
-// the way between the two levels in one frame (or two, with a partly lit one), the
-// region's brightest channel (or its mean, if larger) steps by min_contrast_levels or
-// more, the step stands out from what the rest of the frame did at that instant (codec
-// key frames, lighting changes and camera shake step many regions at once), and the
-// region then holds its new level, or returns to the old one, for 8 more frames (a moving
-// foot does not). Mains flicker is taken out first: every frame's overall gain against a
-// slow average of each cell, applied to the scene's light only. When locating, the cells
-// around a step must look like a light switching (no cells stepping the other way, as an
-// edge moved by shake makes them; not a row or a column of cells, as a shifted band), and
-// the LED is the region with the largest step among those whose contrast is at least
-// half the best one's. Limits: a small, dim LED under strong camera shake is missed
-// rather than mistaken (the detector prefers kNotFound to a wrong instant); flicker is
-// over-corrected where the lit LED fills much of its region.
+// Without an ROI, the frame is cut into cells of cell_px (every other row sampled) and
+// every 2 x 2 block of cells is a candidate region; each keeps a few frames of its
+// brightness and a fixed-size record per step it made, never pixels. The measure is the
+// sum of B, G and R; mains flicker is taken out by every frame's overall gain against a
+// slow average of each cell; the cells around a step must look like a light switching (no
+// cells stepping the other way, not a row or a column of cells), and the LED is the region
+// with the largest step among those whose contrast is at least half the best one's.
+//
+// In both, a step counts when the signal jumps and holds: the 4 frames before it (the last
+// may be partly lit already) and the min_on_frames after it (which may creep on by half the
+// step) are flat compared with the step, it crosses threshold_frac of the way in one frame
+// (or two), the LED's contrast reaches min_contrast_levels, the step stands out from what
+// the rest of the frame did at that instant (codec key frames, lighting changes and shake
+// step many regions at once), and the signal then holds its new level, or returns to the
+// old one, for 8 more frames. A region's steps under half the contrast of its brightest
+// switch-on are not pulses. Limits: in an ROI where no LED ever lights, a codec's update of
+// a still block by a few grey levels can pass for a dim LED; a small, dim LED under strong
+// camera shake is missed rather than mistaken; located, a 1 px LED under flicker and shake
+// loses to larger steps.
 #pragma once
 
 #include <cstdint>
@@ -78,9 +90,10 @@ struct LedResult {
   /// (medians of the frames around the first switch-on).
   double off_level = 0.0;
   double on_level = 0.0;
-  /// The LED's own on-off contrast: the step of the region's brightest colour channel
-  /// (its brightest pixel), grey levels 0..255, at the first switch-on. This is what
-  /// min_contrast_levels and dim_warning_levels are compared with.
+  /// The LED's own on-off contrast, grey levels 0..255, at the first switch-on: with an
+  /// ROI, the brightest-channel step of the LED's third-brightest pixel; located, the step
+  /// of the brightest channel (or of the mean, if larger) of the block's best cell. This
+  /// is what min_contrast_levels and dim_warning_levels are compared with.
   double contrast_levels = 0.0;
   /// Every switch-on in the clip, in order (at least one: Finish fails otherwise).
   std::vector<LedPulse> pulses;
@@ -91,8 +104,9 @@ struct LedResult {
   std::string Brief() const;
 };
 
-/// Streams frames in decode order; memory stays flat in the clip's length (the automatic
-/// locator keeps O(1) state per image cell, never frames).
+/// Streams frames in decode order; memory stays flat in the clip's length (with an ROI, its
+/// last 5 + min_on_frames pictures; the automatic locator keeps O(1) state per image cell,
+/// never frames).
 class LedDetector {
  public:
   struct Options {

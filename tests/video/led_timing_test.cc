@@ -1,0 +1,110 @@
+// The switch-on and switch-off intervals of a centred exposure (src/video/led_timing.h)
+// against cases worked out by hand: a frame with timestamp t exposes [t - E/2, t + E/2],
+// so an LED on at s lights it for clamp((t + E/2 - s) / E, 0, 1) of its exposure.
+#include "led_timing.h"
+
+#include <gtest/gtest.h>
+
+namespace liftoff::video::internal {
+namespace {
+
+constexpr double kT = 1e6;  // frame interval in these cases, ns (whole numbers keep it exact)
+
+TEST(SwitchOnInterval, PartialFrameWithKnownExposureIsExact) {
+  // E = 0.5 T, lit frame at 10 T lit 30 %: s = 10 T + E/2 - 0.3 E = 10.1 T
+  const InstantInterval interval =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {0.3, 0.3}, {0.5 * kT, 0.5 * kT});
+  EXPECT_NEAR(interval.low_ns, 10.1 * kT, 1e-6);
+  EXPECT_NEAR(interval.high_ns, 10.1 * kT, 1e-6);
+}
+
+TEST(SwitchOnInterval, PartialFrameWithUnknownExposureSpansEveryExposureUpToTheInterval) {
+  // lit 30 %: s = t + (0.5 - 0.3) E for E in (0, T]: [t, t + 0.2 T], middle t + 0.1 T
+  const InstantInterval interval =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {0.3, 0.3}, {0.0, kT});
+  EXPECT_NEAR(interval.low_ns, 10 * kT, 1e-6);
+  EXPECT_NEAR(interval.high_ns, 10.2 * kT, 1e-6);
+  EXPECT_EQ(interval.Middle(), static_cast<int64_t>(10.1 * kT));
+  // lit 80 %: s = t - 0.3 E: [t - 0.3 T, t]
+  const InstantInterval later =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {0.8, 0.8}, {0.0, kT});
+  EXPECT_NEAR(later.low_ns, 9.7 * kT, 1e-6);
+  EXPECT_NEAR(later.high_ns, 10 * kT, 1e-6);
+}
+
+TEST(SwitchOnInterval, HalfLitFrameDatesTheSwitchAtItsTimestampWhateverTheExposure) {
+  const InstantInterval interval =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {0.5, 0.5}, {0.0, kT});
+  EXPECT_NEAR(interval.low_ns, 10 * kT, 1e-6);
+  EXPECT_NEAR(interval.high_ns, 10 * kT, 1e-6);
+}
+
+TEST(SwitchOnInterval, FullyLitFrameAfterADarkOneSpansTheGapBetweenThem) {
+  // E known: after the dark exposure's end (9 T + E/2), before the lit one's start
+  const InstantInterval known =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.4 * kT, 0.4 * kT});
+  EXPECT_NEAR(known.low_ns, 9.2 * kT, 1e-6);
+  EXPECT_NEAR(known.high_ns, 9.8 * kT, 1e-6);
+  // E unknown: the whole interval between the timestamps, half-width T / 2
+  const InstantInterval unknown =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT});
+  EXPECT_NEAR(unknown.low_ns, 9 * kT, 1e-6);
+  EXPECT_NEAR(unknown.high_ns, 10 * kT, 1e-6);
+  EXPECT_EQ(unknown.HalfWidth(), static_cast<int64_t>(0.5 * kT));
+}
+
+TEST(SwitchOnInterval, DroppedFramesWidenTheIntervalToTheRealTimestamps) {
+  // two frames missing between the dark frame (7 T) and the lit one (10 T); the exposure
+  // is still at most the usual interval T
+  const InstantInterval interval =
+      SwitchOnInterval(7 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT});
+  EXPECT_NEAR(interval.low_ns, 7 * kT, 1e-6);
+  EXPECT_NEAR(interval.high_ns, 10 * kT, 1e-6);
+  EXPECT_EQ(interval.Middle(), static_cast<int64_t>(8.5 * kT));
+  // with a partly lit last frame (30 %), only the lit frame matters: [10 T, 10.2 T]
+  const InstantInterval partial =
+      SwitchOnInterval(7 * kT, {0.0, 0.0}, 10 * kT, {0.3, 0.3}, {0.0, kT});
+  EXPECT_NEAR(partial.low_ns, 10 * kT, 1e-6);
+  EXPECT_NEAR(partial.high_ns, 10.2 * kT, 1e-6);
+}
+
+TEST(SwitchOnInterval, NoiseBandsWidenTheInterval) {
+  // E = T; lit in [0.2, 0.4]: s in [t + 0.1 T, t + 0.3 T]; a dark frame lit up to 15 %
+  // allows nothing earlier than 9 T + 0.35 T
+  const InstantInterval interval =
+      SwitchOnInterval(9 * kT, {0.0, 0.15}, 10 * kT, {0.2, 0.4}, {kT, kT});
+  EXPECT_NEAR(interval.low_ns, 10.1 * kT, 1e-6);
+  EXPECT_NEAR(interval.high_ns, 10.3 * kT, 1e-6);
+  // the lit frame may be whole (band up to 1): anything after the dark frame's allowance
+  const InstantInterval whole =
+      SwitchOnInterval(9 * kT, {0.0, 0.15}, 10 * kT, {0.9, 1.0}, {kT, kT});
+  EXPECT_NEAR(whole.low_ns, 9.35 * kT, 1e-6);
+  EXPECT_NEAR(whole.high_ns, 9.6 * kT, 1e-6);
+}
+
+TEST(SwitchOnInterval, InconsistentFractionsFallBackToShorterExposures) {
+  // E given as T: the dark frame at 9 T wants s >= 9.5 T, the lit one at 9.2 T (lit 90 %)
+  // s = 8.8 T: no instant fits. Exposures e < T: s in [9 T + e/2, 9.2 T - 0.4 e], which
+  // holds for e <= 0.2 T / 0.9: the union is [9 T + 0.1 T / 0.9, 9.2 T]
+  const InstantInterval interval =
+      SwitchOnInterval(9 * kT, {0.0, 0.0}, 9.2 * kT, {0.9, 0.9}, {kT, kT});
+  EXPECT_NEAR(interval.low_ns, 9 * kT + 0.1 * kT / 0.9, 1e-3);
+  EXPECT_NEAR(interval.high_ns, 9.2 * kT, 1e-3);
+}
+
+TEST(SwitchOffInterval, IsTheSwitchOnWithTimeReversed) {
+  // last lit frame at 10 T lit for its first 30 %, E unknown up to T: s = t - E/2 + 0.3 E
+  // = t - 0.2 E: [t - 0.2 T, t]
+  const InstantInterval partial =
+      SwitchOffInterval(10 * kT, {0.3, 0.3}, 11 * kT, {0.0, 0.0}, {0.0, kT});
+  EXPECT_NEAR(partial.low_ns, 9.8 * kT, 1e-6);
+  EXPECT_NEAR(partial.high_ns, 10 * kT, 1e-6);
+  // fully lit, then dark: between the two timestamps
+  const InstantInterval whole =
+      SwitchOffInterval(10 * kT, {1.0, 1.0}, 11 * kT, {0.0, 0.0}, {0.0, kT});
+  EXPECT_NEAR(whole.low_ns, 10 * kT, 1e-6);
+  EXPECT_NEAR(whole.high_ns, 11 * kT, 1e-6);
+}
+
+}  // namespace
+}  // namespace liftoff::video::internal
