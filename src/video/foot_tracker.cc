@@ -190,6 +190,10 @@ struct FootTracker::Impl {
   double scale = 1;  // work px per frame px
   cv::Rect region_work_px;  // the foot region in work px
   cv::Mat work, accumulated;
+  // the templates' grey image and window, and the last frame's global shift from it (work
+  // px): a shaken camera moves every patch at once, further than one can follow alone
+  cv::Mat reference_grey, window, grey;
+  cv::Point2d global_shift_px;
   int accumulated_frames = 0;
   bool initialised = false;
   std::vector<TrackedPatch> patches;
@@ -203,6 +207,13 @@ struct FootTracker::Impl {
   void MakeWorkImage(const cv::Mat& bgr);
   void InitialisePatches();
   void MeasurePatches();
+  // the work image in grey with the foot region filled by its mean: the ground around it,
+  // whose shift is the camera's
+  void GroundGrey(const cv::Mat& bgr, cv::Mat& out) const {
+    cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
+    const cv::Rect region = region_work_px & cv::Rect(0, 0, out.cols, out.rows);
+    out(region).setTo(cv::mean(out(region)));
+  }
 };
 
 void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
@@ -271,15 +282,23 @@ void FootTracker::Impl::InitialisePatches() {
 }
 
 void FootTracker::Impl::MeasurePatches() {
+  // the whole work image's shift against the templates' (phase correlation): each patch
+  // starts from where it was, moved as much as the picture moved since the last frame
+  GroundGrey(work, grey);
+  const cv::Point2d shift = cv::phaseCorrelate(reference_grey, grey, window);
+  const cv::Point2d moved = shift - global_shift_px;
+  global_shift_px = shift;
   for (TrackedPatch& patch : patches) {
     float rise = kNaN;
     if (!patch.lost) {
-      const PatchMatch match = internal::RegisterPatch(patch.templ, work, patch.position_px);
+      const PatchMatch match =
+          internal::RegisterPatch(patch.templ, work, patch.position_px + moved);
       const double limit =
           patch.typical_residual > 0 ? kResidualFactor * patch.typical_residual + kResidualFloor
                                      : std::numeric_limits<double>::infinity();
-      const bool jumped = std::abs(match.origin_px.y - patch.position_px.y) > kPatchPx / 2.0 ||
-                          std::abs(match.origin_px.x - patch.position_px.x) > kPatchPx / 2.0;
+      const cv::Point2d step = match.origin_px - patch.position_px;
+      const bool jumped = std::abs(step.y) > kPatchPx / 2.0 + std::abs(moved.y) ||
+                          std::abs(step.x) > kPatchPx / 2.0 + std::abs(moved.x);
       if (match.ok && !jumped && match.residual_rms <= limit && std::abs(match.gain) < kMaxGain) {
         patch.position_px = match.origin_px;
         patch.typical_residual = patch.typical_residual > 0
@@ -354,6 +373,8 @@ Status FootTracker::Process(const Frame& frame) {
       if (++s.accumulated_frames == kTemplateFrames) {
         s.work = s.accumulated / kTemplateFrames;
         s.InitialisePatches();
+        s.GroundGrey(s.work, s.reference_grey);
+        cv::createHanningWindow(s.window, s.reference_grey.size(), CV_32F);
         s.initialised = true;
         s.accumulated.release();
         s.MakeWorkImage(bgr);
@@ -726,6 +747,28 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   return search;
 }
 
+// Where a line through the 5 frames around the curve's first sustained crossing of `level`
+// (frames [first, last]) crosses it, s; NaN when it does not.
+double LocalCrossingS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                      size_t first, size_t last, double level) {
+  size_t at = last + 1;
+  for (size_t f = first; f + 2 <= last && at > last; ++f) {
+    if (height[f] >= level && height[f + 1] >= level && height[f + 2] >= level) at = f;
+  }
+  if (at > last || at < first + 2) return kNaNd;
+  double st = 0, sh = 0, stt = 0, sth = 0, n = 0;
+  const double origin_s = Seconds(samples[at].t_ns);
+  for (size_t f = at - 2; f <= at + 2 && f <= last; ++f) {
+    if (!std::isfinite(height[f])) continue;
+    const double t = Seconds(samples[f].t_ns) - origin_s;
+    st += t, sh += height[f], stt += t * t, sth += t * height[f], n += 1;
+  }
+  const double slope = (n * sth - st * sh) / (n * stt - st * st);
+  if (!(slope > 0)) return kNaNd;
+  const double intercept = (sh - slope * st) / n;
+  return origin_s + (level - intercept) / slope;
+}
+
 // The frames either side of t_ns and the instant with its uncertainty.
 TimedEvent MakeEvent(const std::vector<HeightSample>& samples, double t_s, double uncertainty_s) {
   TimedEvent event;
@@ -913,8 +956,15 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   track.max_rise_px = search.max_rise_px;
   if (!search.not_found.empty()) return NotFoundError(search.not_found);
   const internal::RiseFit& fit = search.fit;
-  // with a codec's lag the fit only bounds the instant: its middle
-  const double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
+  // with a codec's lag the fit only bounds the instant: its middle; without, the curve itself
+  // is exact to noise, and a line through the frames around its crossing beats the model's
+  // two terms (when it lies inside the model's interval)
+  double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
+  if (search.lag_bound_px == 0) {
+    const double local_s = LocalCrossingS(samples, selection.height_px, search.fit_first,
+                                          search.fit_last, fit.level + track.threshold_px);
+    if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
+  }
   const double fit_spread =
       std::max(crossing_s - fit.crossing_low_s, fit.crossing_high_s - crossing_s);
   const double rate = std::max(fit.rate_at_crossing, 1e-9);

@@ -47,15 +47,11 @@ struct Scene {
   int64_t exposure_ns = 0;
   int64_t frame_ns = 0;
 
-  // The frame whose exposure starts at start_ns. These tests stamp frames with the start
-  // of their exposure, the convention the tracker dates by (t + E/2); the renderer centres
-  // the exposure on the time it is given.
-  cv::Mat RenderStartingAt(int64_t index, int64_t start_ns) {
-    return renderer.RenderFrame(index, start_ns + exposure_ns / 2);
-  }
-  // The truth a frame starting at t_ns shows: the foot's rise at mid-exposure, px.
+  // The frame stamped t_ns: its exposure centred there, as the tracker dates frames.
+  cv::Mat Render(int64_t index, int64_t t_ns) { return renderer.RenderFrame(index, t_ns); }
+  // The truth a frame stamped t_ns shows: the foot's rise at mid-exposure, px.
   double TrueRisePx(int64_t t_ns) const {
-    return renderer.foot_rest_bottom_px() - renderer.FootBottomPxAt(t_ns + exposure_ns / 2);
+    return renderer.foot_rest_bottom_px() - renderer.FootBottomPxAt(t_ns);
   }
   cv::Rect FootRoi() const {
     const RegionPx roi = renderer.foot_roi_px();
@@ -93,7 +89,7 @@ Result<FootTrack> TrackClip(Scene& scene, const FootTracker::Options& options,
     Frame frame;
     frame.index = k;
     frame.t_ns = k * scene.frame_ns;
-    frame.bgr = scene.RenderStartingAt(k, frame.t_ns);
+    frame.bgr = scene.Render(k, frame.t_ns);
     if (edit) edit(frame.bgr);
     const Status status = tracker.Process(frame);
     if (!status.ok()) return status;
@@ -135,11 +131,11 @@ TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
   for (size_t i = 0; i < heights_px.size(); ++i) {
     int64_t t_ns = static_cast<int64_t>(i) * scene.frame_ns;
     if (heights_px[i] > 0) {
-      t_ns = TruthNsAboveMm(scene, heights_px[i] / px_per_mm) - scene.exposure_ns / 2;
+      t_ns = TruthNsAboveMm(scene, heights_px[i] / px_per_mm);
     }
     times_ns.push_back(t_ns);
     Frame frame{static_cast<int64_t>(i), t_ns, false,
-                scene.RenderStartingAt(static_cast<int64_t>(i), t_ns)};
+                scene.Render(static_cast<int64_t>(i), t_ns)};
     ASSERT_TRUE(tracker.Process(frame).ok());
   }
   Result<FootTrack> track = tracker.Finish();
@@ -253,8 +249,8 @@ TEST(FootTracker, ThresholdInstantIsWithinAFractionOfAFrameOfTruth) {
   EXPECT_LE(std::abs(error_ns), track->above_threshold.uncertainty_ns);
   EXPECT_LT(track->above_threshold.uncertainty_ns, scene.frame_ns);
   // the frames either side of the instant bracket the truth (frame k starts at k / 60 s)
-  EXPECT_LE(track->above_threshold.frame_before * scene.frame_ns + scene.exposure_ns / 2, truth_ns);
-  EXPECT_GE(track->above_threshold.frame_after * scene.frame_ns + scene.exposure_ns / 2, truth_ns);
+  EXPECT_LE(track->above_threshold.frame_before * scene.frame_ns, truth_ns);
+  EXPECT_GE(track->above_threshold.frame_after * scene.frame_ns, truth_ns);
   EXPECT_NEAR(track->threshold_px, scene.renderer.px_per_mm(), 1e-9);
   EXPECT_NEAR(track->rest_rise_px, 0.0, 0.01);
   // the onset: the knee of the curve, where the foot leaves the ground
