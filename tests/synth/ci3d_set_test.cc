@@ -1,0 +1,136 @@
+// The 3D CI set as rendered by `liftoff synth --set ci3d` (CTest fixture ci3d_set): every
+// clip decodes to its truth's frames and timestamps, its LED lights where and when the
+// truth says (and never in the reject clip), and the set has the variety it promises.
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "liftoff/synth/trial3d.h"
+
+namespace liftoff::synth {
+namespace {
+
+std::filesystem::path SetDir() {
+  const char* from_environment = std::getenv("LIFTOFF_CI3D_SET_DIR");
+  return from_environment != nullptr ? from_environment : LIFTOFF_CI3D_SET_DIR;
+}
+
+#define REQUIRE_SET()                                                                  \
+  do {                                                                                 \
+    if (!std::filesystem::exists(SetDir() / "set.json"))                               \
+      GTEST_SKIP() << "the 3D CI set is not rendered in " << SetDir()                  \
+                   << " (no headless GL here? run liftoff synth --set ci3d -o DIR)";   \
+  } while (0)
+
+nlohmann::json Truth(const Trial3dSpec& spec) {
+  std::ifstream in(SetDir() / spec.id / "truth.json");
+  return nlohmann::json::parse(in);
+}
+
+cv::Rect Roi(const nlohmann::json& roi) {
+  return {roi[0].get<int>(), roi[1].get<int>(), roi[2].get<int>(), roi[3].get<int>()};
+}
+
+TEST(Ci3dSet, EveryClipDecodesToItsTruthsFramesAndTimes) {
+  REQUIRE_SET();
+  for (const Trial3dSpec& spec : Ci3dSet()) {
+    SCOPED_TRACE(spec.id);
+    const nlohmann::json truth = Truth(spec);
+    EXPECT_EQ(truth["id"], spec.id);
+    cv::VideoCapture capture((SetDir() / spec.id / truth["video"].get<std::string>()).string());
+    ASSERT_TRUE(capture.isOpened());
+    const auto& pts = truth["pts"];
+    size_t frames = 0;
+    for (cv::Mat frame; capture.read(frame); ++frames) {
+      ASSERT_LT(frames, pts.size());
+      ASSERT_EQ(frame.cols, truth["width"].get<int>());
+      ASSERT_EQ(frame.rows, truth["height"].get<int>());
+      const double position_s = capture.get(cv::CAP_PROP_POS_MSEC) / 1000;
+      // OpenCV 4.6 reads 0 for the frames drained from an H.264 decoder at the end
+      if (frames > 0 && position_s == 0.0) continue;
+      EXPECT_NEAR(position_s, pts[frames].get<double>(), 0.0011) << "frame " << frames;
+    }
+    EXPECT_EQ(frames, truth["n_frames"].get<size_t>());
+  }
+}
+
+// The LED's region brightens by more than 40 grey levels (red, summed over the LED's
+// disc) from the frame before led_first_lit_frame to the frame after it, and stays dark
+// in the clip where it never switches on.
+TEST(Ci3dSet, LedLightsWhenTheTruthSays) {
+  REQUIRE_SET();
+  for (const Trial3dSpec& spec : Ci3dSet()) {
+    SCOPED_TRACE(spec.id);
+    const nlohmann::json truth = Truth(spec);
+    cv::VideoCapture capture((SetDir() / spec.id / truth["video"].get<std::string>()).string());
+    std::vector<double> red;
+    const cv::Rect roi = Roi(truth["led_roi"]);
+    const cv::Point centre(static_cast<int>(truth["led_center_px"][0].get<double>()),
+                           static_cast<int>(truth["led_center_px"][1].get<double>()));
+    const cv::Rect core = cv::Rect(centre - cv::Point(1, 1), cv::Size(3, 3)) & roi;
+    for (cv::Mat frame; capture.read(frame);) red.push_back(cv::mean(frame(core))[2]);
+    ASSERT_EQ(red.size(), truth["n_frames"].get<size_t>());
+    if (truth["t_led_on"].is_null()) {
+      EXPECT_TRUE(truth["led_first_lit_frame"].is_null());
+      EXPECT_LT(*std::max_element(red.begin(), red.end()) - red.front(), 40.0);
+      continue;
+    }
+    const size_t first = truth["led_first_lit_frame"].get<size_t>();
+    ASSERT_GT(first, 0u);
+    EXPECT_GT(red[first + 1] - red[first - 1], 40.0);
+    EXPECT_GT(red.back() - red.front(), 40.0);
+  }
+}
+
+TEST(Ci3dSet, OkClipsLiftAndRejectClipsSayWhy) {
+  REQUIRE_SET();
+  for (const Trial3dSpec& spec : Ci3dSet()) {
+    SCOPED_TRACE(spec.id);
+    const nlohmann::json truth = Truth(spec);
+    const auto& h_mm = truth["h_mm"];
+    if (truth["expect"] == "ok") {
+      EXPECT_GT(h_mm.back().get<double>(), 1.0);
+      EXPECT_GT(truth["t_lift_1mm"].get<double>(), truth["t_led_on"].get<double>());
+      const size_t lifted = truth["first_lifted_frame"].get<size_t>();
+      EXPECT_GT(h_mm[lifted].get<double>(), 0.0);
+      EXPECT_EQ(h_mm[lifted - 1].get<double>(), 0.0);
+    } else {
+      EXPECT_TRUE(truth.contains("reason"));
+    }
+  }
+  EXPECT_EQ(Truth(Ci3dSet()[8])["reason"], "LED never switches on");
+  EXPECT_EQ(Truth(Ci3dSet()[9])["reason"], "foot never lifts");
+}
+
+TEST(Ci3dSet, HasTheVarietyItPromises) {
+  std::set<std::string> seen;
+  for (const Trial3dSpec& spec : Ci3dSet()) {
+    seen.insert(std::string(CameraViewName(spec.scene.view)));
+    seen.insert(std::string(FootShapeName(spec.scene.foot_shape)));
+    seen.insert(std::to_string(spec.scene.height_px) + "p");
+    seen.insert(std::string(VideoCodecName(spec.codec)));
+    if (spec.drop_probability > 0) seen.insert("drops");
+    if (spec.scene.floor == FloorKind::kGlossy) seen.insert("glossy");
+    if (spec.scene.led_radius_m < 0.004) seen.insert("small-led");
+    if (spec.scene.light_level < 0.5 && spec.noise_sigma > 0) seen.insert("low-light-noise");
+    if (spec.scene.light_elevation_deg < 20) seen.insert("low-hard-light");
+    if (!spec.led_switches_on) seen.insert("led-never-on");
+    if (spec.max_rotation_rad < 0.3) seen.insert("never-lifts");
+  }
+  for (const char* tag : {"side", "oblique", "front", "sphere", "block", "rubber-tip", "480p",
+                          "720p", "h264", "mjpeg", "drops", "glossy", "small-led",
+                          "low-light-noise", "low-hard-light", "led-never-on", "never-lifts"}) {
+    EXPECT_TRUE(seen.count(tag) == 1) << tag;
+  }
+}
+
+}  // namespace
+}  // namespace liftoff::synth
