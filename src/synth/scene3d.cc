@@ -317,6 +317,8 @@ Status Scene3dOptions::Validate() const {
   if (!(light_level >= 0.05 && light_level <= 2)) return out_of("light_level", light_level, 0.05, 2);
   if (shadow_map_px < 256 || shadow_map_px > 8192)
     return out_of("shadow_map_px", shadow_map_px, 256, 8192);
+  if (msaa_samples != 0 && msaa_samples != 2 && msaa_samples != 4 && msaa_samples != 8)
+    return out_of("msaa_samples (0, 2, 4 or 8)", msaa_samples, 0, 8);
   if (!(led_radius_m >= 0.001 && led_radius_m <= 0.02))
     return out_of("led_radius_m", led_radius_m, 0.001, 0.02);
   for (const double channel : led_rgb) {
@@ -337,7 +339,8 @@ std::string Scene3dMjcf(const Scene3dOptions& options, Foot lifting_foot) {
     << "<option><flag contact='disable' gravity='disable'/></option>\n"
     << "<statistic extent='1' center='0 0 0.1'/>\n"
     << "<visual>\n<global offwidth='" << options.width_px << "' offheight='" << options.height_px
-    << "'/>\n<quality shadowsize='" << options.shadow_map_px << "' offsamples='4'/>\n"
+    << "'/>\n<quality shadowsize='" << options.shadow_map_px << "' offsamples='"
+    << options.msaa_samples << "'/>\n"
     << "<map znear='0.02' zfar='20' shadowclip='1.2' shadowscale='0.5'/>\n"
     << "<headlight ambient='" << 0.12 * options.light_level << ' ' << 0.12 * options.light_level
     << ' ' << 0.12 * options.light_level << "' diffuse='" << 0.15 * options.light_level << ' '
