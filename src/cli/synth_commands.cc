@@ -92,9 +92,15 @@ int RunSet3d(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   auto summary = synth::WriteCi3dSet(command.output_dir, progress);
   if (!summary.ok()) return ReportError(summary.status(), err);
   for (const synth::WrittenTrial3d& written : summary->trials) {
+    const auto seconds = [](const std::optional<double>& value, int places) {
+      return value ? FormatFixed(*value, places) : std::string("-");
+    };
     out << written.folder.filename().string() << ": " << written.frames << " frames, render "
         << PerFrameMs(written.render_seconds, static_cast<size_t>(written.frames)) << ", encode "
-        << PerFrameMs(written.encode_seconds, static_cast<size_t>(written.frames)) << '\n';
+        << PerFrameMs(written.encode_seconds, static_cast<size_t>(written.frames)) << "; "
+        << written.expect << ", LED on " << seconds(written.t_led_on_s, 3) << " s, 1 mm at "
+        << seconds(written.t_lift_1mm_s, 4) << " s, " << seconds(written.theta_at_lift_1mm_rad, 4)
+        << " rad\n";
   }
   out << summary->Brief() << '\n' << "renderer: " << summary->renderer << '\n'
       << "index: " << (command.output_dir / "set.json").string() << '\n';

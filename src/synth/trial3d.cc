@@ -508,10 +508,17 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const std::filesyst
   // the controller's log and the truth
   const std::vector<ControllerSample> log = ControllerLog3d(spec, timing.duration_s);
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.controller_path, ControllerCsv(log)));
-  written.truth_json =
-      TruthJson(spec, motion, *renderer, timing.pts_ns, shake, log, video_name, timing.duration_s)
-          .dump(1) +
-      "\n";
+  const nlohmann::json truth =
+      TruthJson(spec, motion, *renderer, timing.pts_ns, shake, log, video_name, timing.duration_s);
+  written.truth_json = truth.dump(1) + "\n";
+  written.expect = truth["expect"].get<std::string>();
+  const auto seconds = [&](const char* key) -> std::optional<double> {
+    return truth.contains(key) && truth[key].is_number() ? std::optional(truth[key].get<double>())
+                                                         : std::nullopt;
+  };
+  written.t_led_on_s = seconds("t_led_on");
+  written.t_lift_1mm_s = seconds("t_lift_1mm");
+  written.theta_at_lift_1mm_rad = seconds("theta_at_lift_1mm_rad");
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.truth_path, written.truth_json));
   written.frames = static_cast<int64_t>(timing.pts_ns.size());
   written.render_seconds = SecondsFromNs(render_ns);

@@ -138,8 +138,11 @@ struct WrittenTrial3d {
   std::filesystem::path folder, video_path, controller_path, truth_path;
   int64_t frames = 0;
   double render_seconds = 0.0, encode_seconds = 0.0;
-  /// The truth as written.
+  /// The truth as written, and its answers: "ok" or "reject"; the LED switch-on, the
+  /// foot's 1 mm instant (video clock, s) and the rotation there, rad (unset: none).
   std::string truth_json;
+  std::string expect;
+  std::optional<double> t_led_on_s, t_lift_1mm_s, theta_at_lift_1mm_rad;
 };
 
 /// Renders and writes one trial into `output_dir`/<id>/. Needs a current OpenGL context
