@@ -41,17 +41,6 @@ double FootWidthM(FootShape shape) {
   return shape == FootShape::kBlock ? 2 * kBlockHalf[0] : 2 * kFootRadius;
 }
 
-// the neighbours of a foot: same side, other end; same end, other side
-std::array<Foot, 2> Neighbours(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return {Foot::kC, Foot::kB};
-    case Foot::kB: return {Foot::kD, Foot::kA};
-    case Foot::kC: return {Foot::kA, Foot::kD};
-    case Foot::kD: return {Foot::kB, Foot::kC};
-  }
-  return {Foot::kC, Foot::kB};
-}
-
 std::array<double, 3> TapeRgb(Foot foot) {
   switch (foot) {
     case Foot::kA: return {0.10, 0.25, 0.85};  // blue
@@ -207,32 +196,56 @@ void WriteVertebraRods(const cv::Vec3d& centre, const std::string& name, bool fr
   }
 }
 
-void WriteRobot(const Scene3dOptions& options, Mjcf& m) {
-  m << "<body name='robot'>\n<freejoint name='robot'/>\n";
-  // hips (back) and shoulders (front): a box from the end vertebra outwards, a cross piece
-  for (const double sign : {-1.0, 1.0}) {
-    const double end_x = sign * 2 * kVertebraSpacing;
-    m << "<geom type='box' material='body' size='0.063 0.035 0.03' pos='"
-      << cv::Vec3d(end_x + sign * 0.063, 0, kSpineZ) << "'/>\n"
-      << "<geom type='box' material='body' size='0.006 0.0905 0.03' pos='"
-      << cv::Vec3d(sign * kFootX, 0, kSpineZ) << "'/>\n";
+// the other foot at the same end (the lifting foot's half rolls about its contact)
+Foot SameEndPartner(Foot foot) {
+  switch (foot) {
+    case Foot::kA: return Foot::kB;
+    case Foot::kB: return Foot::kA;
+    case Foot::kC: return Foot::kD;
+    case Foot::kD: return Foot::kC;
   }
-  // the four vertebrae that do not turn, with the cables between neighbours drawn thin
-  for (const int index : {-2, -1, 1, 2}) {
-    const cv::Vec3d centre(index * kVertebraSpacing, 0, kSpineZ);
-    WriteVertebraRods(centre, "v" + std::to_string(index + 3), true, true, m);
+  return Foot::kB;
+}
+
+bool IsFront(Foot foot) { return foot == Foot::kA || foot == Foot::kB; }
+
+// one end of the robot: its box and cross piece, its two vertebrae with the cables between
+// them, its two legs and feet; the lifting foot's end on a hinge along the spine through
+// the other foot's floor contact
+void WriteHalf(const Scene3dOptions& options, bool front, Foot lifting_foot, Mjcf& m) {
+  const double sign = front ? 1.0 : -1.0;
+  m << "<body name='" << (front ? "front" : "rear") << "'>\n";
+  if (IsFront(lifting_foot) == front) {
+    cv::Vec3d pivot = FootRestCenter(SameEndPartner(lifting_foot), options.foot_shape);
+    pivot[2] = 0;
+    m << "<joint name='roll' type='hinge' axis='1 0 0' pos='" << pivot << "'/>\n";
   }
-  for (const int index : {-2, 1}) {
-    const cv::Vec3d a(index * kVertebraSpacing, 0, kSpineZ);
-    const cv::Vec3d b = a + cv::Vec3d(kVertebraSpacing, 0, 0);
-    const cv::Vec3d tips[4] = {{0.065, 0, 0.096}, {0.065, 0, -0.096}, {-0.065, -0.096, 0},
-                               {-0.065, 0.096, 0}};
-    for (const cv::Vec3d& tip : tips) {
-      m << "<geom type='capsule' material='leg' size='0.0012' fromto='" << (a + tip) << ' '
-        << (b + tip) << "'/>\n";
-    }
+  const double end_x = sign * 2 * kVertebraSpacing;
+  m << "<geom type='box' material='body' size='0.063 0.035 0.03' pos='"
+    << cv::Vec3d(end_x + sign * 0.063, 0, kSpineZ) << "'/>\n"
+    << "<geom type='box' material='body' size='0.006 0.0905 0.03' pos='"
+    << cv::Vec3d(sign * kFootX, 0, kSpineZ) << "'/>\n";
+  for (const int index : {1, 2}) {
+    const cv::Vec3d centre(sign * index * kVertebraSpacing, 0, kSpineZ);
+    WriteVertebraRods(centre, "v" + std::to_string(3 + static_cast<int>(sign) * index), true, true, m);
   }
-  for (const Foot foot : {Foot::kA, Foot::kB, Foot::kC, Foot::kD}) WriteFoot(options, foot, m);
+  const cv::Vec3d a(sign * kVertebraSpacing, 0, kSpineZ), b(sign * 2 * kVertebraSpacing, 0, kSpineZ);
+  const cv::Vec3d tips[4] = {{0.065, 0, 0.096}, {0.065, 0, -0.096}, {-0.065, -0.096, 0},
+                             {-0.065, 0.096, 0}};
+  for (const cv::Vec3d& tip : tips) {
+    m << "<geom type='capsule' material='leg' size='0.0012' fromto='" << (a + tip) << ' '
+      << (b + tip) << "'/>\n";
+  }
+  for (const Foot foot : {Foot::kA, Foot::kB, Foot::kC, Foot::kD}) {
+    if (IsFront(foot) == front) WriteFoot(options, foot, m);
+  }
+  m << "</body>\n";
+}
+
+void WriteRobot(const Scene3dOptions& options, Foot lifting_foot, Mjcf& m) {
+  m << "<body name='robot'>\n";
+  WriteHalf(options, false, lifting_foot, m);
+  WriteHalf(options, true, lifting_foot, m);
   // the centre vertebra: a disc with a white marker, on a hinge about the spine axis
   m << "<body name='vertebra' pos='0 0 " << kSpineZ << "'>\n"
     << "<joint name='vertebra' type='hinge' axis='1 0 0'/>\n"
@@ -384,7 +397,7 @@ std::string Scene3dMjcf(const Scene3dOptions& options, Foot lifting_foot) {
   // the camera: MuJoCo's looks along its -z; x right, y up
   m << "<camera name='camera' fovy='" << options.fovy_deg << "' pos='" << camera.position
     << "' xyaxes='" << camera.right << ' ' << camera.up << "'/>\n";
-  WriteRobot(options, m);
+  WriteRobot(options, lifting_foot, m);
   m << "</worldbody>\n</mujoco>\n";
   return m.text.str();
 }
@@ -401,7 +414,7 @@ struct SceneRenderer3d::Impl {
   mjrContext context;
   bool have_scene = false, have_context = false;
   int led_material = -1;
-  int vertebra_qpos = -1;
+  int vertebra_qpos = -1, roll_qpos = -1;
   CameraPose pose;
   double focal_px = 0;
   int width = 0, height = 0;
@@ -433,12 +446,6 @@ Result<mjModel*> CompileMjcf(const std::string& mjcf) {
   return model;
 }
 
-// rotation about the unit axis `u` by `angle`, as a MuJoCo quaternion (w, x, y, z)
-std::array<double, 4> AxisAngleQuat(const cv::Vec3d& u, double angle) {
-  const double s = std::sin(angle / 2);
-  return {std::cos(angle / 2), u[0] * s, u[1] * s, u[2] * s};
-}
-
 cv::Vec3d Rotate(const cv::Vec3d& u, double angle, const cv::Vec3d& v) {
   // Rodrigues
   return v * std::cos(angle) + u.cross(v) * std::sin(angle) + u * (u.dot(v)) * (1 - std::cos(angle));
@@ -449,16 +456,14 @@ struct Tip {
   double angle = 0;       // rad, right-handed about axis
 };
 
-// the tip that raises the lifting foot's centre by `lift_m`
+// the roll of the lifting foot's end that raises the foot's centre by `lift_m`: about the
+// line along the spine through the other foot's floor contact at that end
 Tip TipFor(Foot foot, FootShape shape, double lift_m) {
-  const std::array<Foot, 2> neighbours = Neighbours(foot);
-  cv::Vec3d a = FootRestCenter(neighbours[0], shape), b = FootRestCenter(neighbours[1], shape);
-  a[2] = b[2] = 0;
   Tip tip;
-  tip.pivot = a;
-  tip.axis = cv::normalize(b - a);
-  const cv::Vec3d centre = FootRestCenter(foot, shape);
-  const cv::Vec3d offset = centre - tip.pivot;
+  tip.pivot = FootRestCenter(SameEndPartner(foot), shape);
+  tip.pivot[2] = 0;
+  tip.axis = cv::Vec3d(1, 0, 0);
+  const cv::Vec3d offset = FootRestCenter(foot, shape) - tip.pivot;
   // the positive sense must raise the foot
   if (tip.axis.cross(offset)[2] < 0) tip.axis = -tip.axis;
   const cv::Vec3d radial = offset - tip.axis * tip.axis.dot(offset);
@@ -486,6 +491,7 @@ Result<std::unique_ptr<SceneRenderer3d>> SceneRenderer3d::Create(const Scene3dOp
   impl->led_material = mj_name2id(impl->model, mjOBJ_MATERIAL, "led");
   const int hinge = mj_name2id(impl->model, mjOBJ_JOINT, "vertebra");
   impl->vertebra_qpos = impl->model->jnt_qposadr[hinge];
+  impl->roll_qpos = impl->model->jnt_qposadr[mj_name2id(impl->model, mjOBJ_JOINT, "roll")];
   impl->pose = MakeCameraPose(options);
   impl->width = options.width_px;
   impl->height = options.height_px;
@@ -516,12 +522,9 @@ Result<std::unique_ptr<SceneRenderer3d>> SceneRenderer3d::Create(const Scene3dOp
 
 cv::Mat SceneRenderer3d::Render(const RobotPose3d& pose, bool led_on) {
   Impl& impl = *impl_;
-  // the robot: tipped as a whole, the vertebra turned
+  // the robot: the lifting foot's end rolled, the vertebra turned
   const Tip tip = TipFor(lifting_foot_, options_.foot_shape, std::max(0.0, pose.lift_m));
-  const cv::Vec3d origin = tip.pivot + Rotate(tip.axis, tip.angle, -tip.pivot);
-  const std::array<double, 4> quat = AxisAngleQuat(tip.axis, tip.angle);
-  for (int i = 0; i < 3; ++i) impl.data->qpos[i] = origin[i];
-  for (int i = 0; i < 4; ++i) impl.data->qpos[3 + i] = quat[static_cast<size_t>(i)];
+  impl.data->qpos[impl.roll_qpos] = tip.axis[0] > 0 ? tip.angle : -tip.angle;
   impl.data->qpos[impl.vertebra_qpos] = pose.vertebra_rad;
   mj_kinematics(impl.model, impl.data);
   mj_camlight(impl.model, impl.data);

@@ -157,14 +157,14 @@ TEST(SceneRenderer3d, FootImageMovesByPixelsPerMmTimesHeight) {
       const cv::Point2d up =
           BlueCentroid((*renderer)->Render({h_mm / 1000, 0}, false), predicted, radius, &count);
       const double moved_px = rest.y - up.y;
-      // the tip also moves the foot sideways a little (a vertical motion only to first
+      // the roll also moves the foot sideways a little (a vertical motion only to first
       // order): up to 6 mm within 5 % and 0.3 px of the pure vertical figure
       if (h_mm <= 6.0) {
         EXPECT_NEAR(moved_px, (*renderer)->PixelsPerMm() * h_mm,
                     0.3 + 0.05 * (*renderer)->PixelsPerMm() * h_mm)
             << "h " << h_mm << " mm";
       }
-      // and the projection of the tipped foot's centre agrees with the pixels
+      // and the projection of the rolled foot's centre agrees with the pixels
       const cv::Point2d projected =
           (*renderer)->ProjectPx((*renderer)->FootCenterM({h_mm / 1000, 0}));
       EXPECT_NEAR(cv::norm((up - rest) - (projected - rest_px)), 0.0, 0.4) << "h " << h_mm;
@@ -172,8 +172,7 @@ TEST(SceneRenderer3d, FootImageMovesByPixelsPerMmTimesHeight) {
   }
 }
 
-// The tip raises the lifting foot's centre by exactly h, and keeps the two neighbours on
-// the floor.
+// The roll raises the lifting foot's centre by exactly h.
 TEST(SceneRenderer3d, TipRaisesTheFootCentreByExactlyTheHeight) {
   REQUIRE_EGL();
   auto renderer = SceneRenderer3d::Create(SmallScene(CameraView::kSide, FootShape::kSphere), Foot::kC);

@@ -15,11 +15,12 @@
 // tape band, four feet of one shape) and the sync LED: a small sphere on a post, emissive
 // when on.
 //
-// Pose: the robot is rigid except for the centre vertebra. A lifting foot of height h is
-// shown by tipping the whole robot about the line through the floor contacts of the
-// lifting foot's two neighbours (same side, other end; same end, other side) so that the
-// lifting foot's centre rises by exactly h (its diagonal partner sinks into the floor by
-// about as much: a limit of the rigid tip). The vertebra turns by its signed angle.
+// Pose: the robot is two rigid ends (box, cross piece, two vertebrae, two legs and feet
+// each) and the centre vertebra. A lifting foot of height h is shown by rolling its end
+// about the line along the spine through the floor contact of the other foot at that end,
+// by the angle that raises the lifting foot's centre by exactly h (the spine's twist; the
+// other end and its feet stay down). The centre vertebra turns by its signed angle about
+// the spine axis.
 //
 // Pixels: row-major, BGR, pixel centres at integer coordinates (pixel (0, 0) covers
 // [-0.5, 0.5)^2); ProjectPx follows the same convention.
@@ -151,7 +152,7 @@ class SceneRenderer3d {
   /// Distance from the camera's centre along its view axis, m.
   double DepthM(const cv::Vec3d& world_m) const;
 
-  /// The lifting foot's centre, world m, at `pose` (tip applied).
+  /// The lifting foot's centre, world m, at `pose` (roll applied).
   cv::Vec3d FootCenterM(const RobotPose3d& pose) const;
   /// Image displacement of the lifting foot's centre per mm it rises from rest, px/mm:
   /// |ProjectPx(centre + 1 mm up) - ProjectPx(centre)|.

@@ -13,7 +13,7 @@
 // lifting foot's height h(t) is the simulated marker height above its reference, linear
 // between the 0.01 s samples, with heights below contact_floor_m counted as 0 (on the
 // floor); the vertebra's angle is the simulated hinge angle. The renderer shows h(t) by
-// tipping the rigid robot (scene3d.h). t_lift and t_lift_1mm are the first instants h(t)
+// rolling the lifting foot's end of the robot (scene3d.h). t_lift and t_lift_1mm are the first instants h(t)
 // exceeds 0 and 1 mm (exact on the linear curve).
 //
 // Camera. Frame i is presented at pts_i (the frame schedule and container rounding of
@@ -80,8 +80,7 @@ struct Trial3dSpec {
   /// The clip ends this long after t_lift_1mm, s (0.1 .. 10), or at max_duration_s,
   /// whichever is first (and at max_duration_s when the foot never lifts). Keep it short:
   /// the simulated robot tips over within about a second of liftoff (the foot 100+ mm up),
-  /// which a rigid tip about two feet cannot show (the diagonal partner sinks into the
-  /// floor by about the lift); the CI set's clips end 9-20 mm up.
+  /// which rolling one end of the robot cannot show; the CI set's clips end 15-21 mm up.
   double after_lift_s = 0.25;
   double max_duration_s = 12.0;
 
