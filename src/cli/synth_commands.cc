@@ -84,12 +84,13 @@ int RunSet(const SynthCommand& command, const Calibration& calibration, std::ost
 }
 
 // The 3D camera's set (trial3d.h): its own folder format, no calibration needed.
-int RunSet3d(const SynthCommand& command, std::ostream& out, std::ostream& err) {
+int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
+             std::ostream& err) {
 #if LIFTOFF_HAVE_SYNTH3D
   const auto progress = [&](int index, int count, const std::string& id) {
     if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
   };
-  auto summary = synth::WriteCi3dSet(command.output_dir, progress);
+  auto summary = synth::WriteCi3dSet(command.output_dir, calibration, progress);
   if (!summary.ok()) return ReportError(summary.status(), err);
   for (const synth::WrittenTrial3d& written : summary->trials) {
     const auto seconds = [](const std::optional<double>& value, int places) {
@@ -103,10 +104,13 @@ int RunSet3d(const SynthCommand& command, std::ostream& out, std::ostream& err) 
         << " rad\n";
   }
   out << summary->Brief() << '\n' << "renderer: " << summary->renderer << '\n'
-      << "index: " << (command.output_dir / "set.json").string() << '\n';
+      << "manifest: " << (command.output_dir / "manifest.json").string() << '\n'
+      << "index: " << (command.output_dir / "set.json").string() << '\n'
+      << "calibration: " << calibration.Brief() << '\n';
   return kExitOk;
 #else
   (void)out;
+  (void)calibration;
   return ReportError(UnsupportedError("liftoff synth --set " + command.set_name +
                                       ": this build has no 3D camera (needs libmujoco-dev and "
                                       "libegl-dev at build time)"),
@@ -132,9 +136,9 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
     err << "liftoff synth: --output DIR is required with a spec or --set\n";
     return kExitUsage;
   }
-  if (command.set_name == "ci3d") return RunSet3d(command, out, err);
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (command.set_name == "ci3d") return RunSet3d(command, *calibration, out, err);
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
                                   : RunSet(command, *calibration, out, err);
 }

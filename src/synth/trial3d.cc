@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "liftoff/core/file.h"
+#include "liftoff/core/json.h"
 #include "liftoff/core/random.h"
 #include "liftoff/core/time.h"
 #include "liftoff/sim/experiment.h"
@@ -462,7 +463,21 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
 
 }  // namespace
 
-Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const std::filesystem::path& output_dir) {
+TrialSpec LiftoffLogSpec3d(const Trial3dSpec& spec, double duration_s) {
+  TrialSpec log = ScheduleSpec(spec, duration_s);
+  log.led.on_video_s = spec.led_switches_on ? spec.led_on_s : -1.0;
+  log.motion.foot = spec.foot;
+  log.motion.rotation = sim::MotionFor(spec.foot).rotation;
+  log.motion.bend_start_s = 0.0;
+  log.motion.bend_end_s = 0.0;
+  log.motion.ramp_start_s = 0.0;
+  log.motion.ramp_rate_rad_per_s = spec.theta_rate_rad_s;
+  log.log.lead_s = 0.0;
+  return log;
+}
+
+Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& calibration,
+                                    const std::filesystem::path& output_dir) {
   LIFTOFF_ASSIGN_OR_RETURN(Motion3d motion, SimulateMotion3d(spec));
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<SceneRenderer3d> renderer,
                            SceneRenderer3d::Create(spec.scene, spec.foot));
@@ -519,6 +534,31 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const std::filesyst
   written.t_led_on_s = seconds("t_led_on");
   written.t_lift_1mm_s = seconds("t_lift_1mm");
   written.theta_at_lift_1mm_rad = seconds("theta_at_lift_1mm_rad");
+
+  // the same test's liftoff-format log and, for an ok clip, its manifest entry
+  written.liftoff_log_path = written.folder / (spec.id + ".csv");
+  LIFTOFF_ASSIGN_OR_RETURN(const Timeline timeline,
+                           Timeline::Create(LiftoffLogSpec3d(spec, timing.duration_s)));
+  LIFTOFF_RETURN_IF_ERROR(WriteTrialLog(timeline, calibration, written.liftoff_log_path));
+  if (written.expect == "ok") {
+    TrialRecord entry;
+    entry.id = spec.id;
+    entry.foot = spec.foot;
+    entry.pulled_group = sim::MotionFor(spec.foot).pulled_group;
+    entry.rotation = sim::MotionFor(spec.foot).rotation;
+    entry.log_path = written.liftoff_log_path;
+    entry.log_format = LogFormat::kLiftoff;
+    entry.video_path = written.video_path;
+    const auto region = [](const nlohmann::json& roi) {
+      return RegionPx{roi[0].get<int>(), roi[1].get<int>(), roi[2].get<int>(), roi[3].get<int>()};
+    };
+    entry.led_roi_px = region(truth["led_roi"]);
+    entry.foot_roi_px = region(truth["foot_roi"]);
+    entry.px_per_mm = truth["pixels_per_mm"].get<double>();
+    entry.notes = "synthetic 3D (liftoff synth --set ci3d, seed " + std::to_string(spec.seed) +
+                  "); truth in " + spec.id + "/truth.json";
+    written.manifest_entry = std::move(entry);
+  }
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.truth_path, written.truth_json));
   written.frames = static_cast<int64_t>(timing.pts_ns.size());
   written.render_seconds = SecondsFromNs(render_ns);
@@ -639,7 +679,7 @@ std::string Set3dSummary::Brief() const {
 }
 
 Result<Set3dSummary> WriteCi3dSet(
-    const std::filesystem::path& output_dir,
+    const std::filesystem::path& output_dir, const Calibration& calibration,
     const std::function<void(int index, int count, const std::string& id)>& progress) {
   const int64_t started_ns = MonotonicNowNs();
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<EglContext> context, EglContext::Create());
@@ -649,7 +689,7 @@ Result<Set3dSummary> WriteCi3dSet(
   nlohmann::json index = {{"set", "ci3d"}, {"renderer", summary.renderer}, {"clips", nlohmann::json::array()}};
   for (size_t i = 0; i < set.size(); ++i) {
     if (progress) progress(static_cast<int>(i), static_cast<int>(set.size()), set[i].id);
-    auto written = WriteTrial3d(set[i], output_dir);
+    auto written = WriteTrial3d(set[i], calibration, output_dir);
     if (!written.ok()) return written.status().WithContext(set[i].id);
     summary.frames += written->frames;
     summary.render_seconds += written->render_seconds;
@@ -661,8 +701,16 @@ Result<Set3dSummary> WriteCi3dSet(
                               {"render_s", written->render_seconds}});
     summary.trials.push_back(std::move(*written));
   }
+  TrialManifest manifest;
+  manifest.description = "liftoff synth set ci3d (" + calibration.name + ")";
+  if (!calibration.source_path.empty()) manifest.calibration_path = calibration.source_path;
+  for (const WrittenTrial3d& trial : summary.trials) {
+    if (trial.manifest_entry) manifest.trials.push_back(*trial.manifest_entry);
+  }
+  LIFTOFF_RETURN_IF_ERROR(WriteManifest(output_dir / "manifest.json", manifest));
   summary.wall_seconds = SecondsFromNs(MonotonicNowNs() - started_ns);
   index["frames"] = summary.frames;
+  index["manifest"] = "manifest.json";
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(output_dir / "set.json", index.dump(1) + "\n"));
   return summary;
 }

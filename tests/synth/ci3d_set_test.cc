@@ -2,6 +2,7 @@
 // clip decodes to its truth's frames and timestamps, its LED lights where and when the
 // truth says (and never in the reject clip), and the set has the variety it promises.
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,9 @@
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "liftoff/core/controller_log.h"
+#include "liftoff/core/manifest.h"
+#include "liftoff/sync/lookup.h"
 #include "liftoff/synth/trial3d.h"
 
 namespace liftoff::synth {
@@ -108,6 +112,38 @@ TEST(Ci3dSet, OkClipsLiftAndRejectClipsSayWhy) {
   }
   EXPECT_EQ(Truth(Ci3dSet()[8])["reason"], "LED never switches on");
   EXPECT_EQ(Truth(Ci3dSet()[9])["reason"], "foot never lifts");
+}
+
+// manifest.json lists the ok clips with their liftoff-format logs; mapping the truth's LED
+// and 1 mm instants onto such a log (sync, linear) gives the truth's rotation to half an
+// encoder count (2 pi / 48000 rad at the vertebra with the 2018 calibration), and the
+// entry's ROIs and scale are the truth's.
+TEST(Ci3dSet, ManifestLogsGiveTheTruthsRotation) {
+  REQUIRE_SET();
+  auto manifest = LoadManifest(SetDir() / "manifest.json");
+  ASSERT_TRUE(manifest.ok()) << manifest.status().ToString();
+  size_t ok_clips = 0;
+  for (const Trial3dSpec& spec : Ci3dSet()) ok_clips += Truth(spec)["expect"] == "ok" ? 1u : 0u;
+  ASSERT_EQ(manifest->trials.size(), ok_clips);
+  for (const TrialRecord& entry : manifest->trials) {
+    SCOPED_TRACE(entry.id);
+    std::ifstream in(SetDir() / entry.id / "truth.json");
+    const nlohmann::json truth = nlohmann::json::parse(in);
+    EXPECT_EQ(std::string(FootName(entry.foot)), truth["foot"].get<std::string>());
+    ASSERT_TRUE(entry.foot_roi_px && entry.px_per_mm && entry.video_path);
+    EXPECT_EQ(entry.foot_roi_px->x_px, truth["foot_roi"][0].get<int>());
+    EXPECT_DOUBLE_EQ(*entry.px_per_mm, truth["pixels_per_mm"].get<double>());
+    auto log = ReadControllerLog(entry.log_path);
+    ASSERT_TRUE(log.ok()) << log.status().ToString();
+    EventTimes times;
+    times.led_on_ns = static_cast<int64_t>(std::llround(truth["t_led_on"].get<double>() * 1e9));
+    times.liftoff_ns = static_cast<int64_t>(std::llround(truth["t_lift_1mm"].get<double>() * 1e9));
+    times.source = "synthetic";
+    auto measured = sync::MeasureLiftoff(*log, times, sync::LookupOptions{});
+    ASSERT_TRUE(measured.ok()) << measured.status().ToString();
+    EXPECT_NEAR(measured->liftoff_rad, truth["theta_at_lift_1mm_rad"].get<double>(),
+                0.5 * 2 * 3.14159265358979 / 48000 + 1e-6);
+  }
 }
 
 TEST(Ci3dSet, HasTheVarietyItPromises) {

@@ -186,6 +186,11 @@ TEST(SceneRenderer3d, TipRaisesTheFootCentreByExactlyTheHeight) {
 // ---------------------------------------------------------------------------------------
 // a whole trial, short and lossless
 
+const Calibration& Calibration2018() {
+  static const Calibration calibration = LoadCalibration(DefaultCalibrationPath()).value();
+  return calibration;
+}
+
 Trial3dSpec ShortSpec() {
   Trial3dSpec spec;
   spec.id = "scene3d-test";
@@ -212,7 +217,7 @@ TEST(Trial3d, PartialLedFrameMatchesTheTruthsFraction) {
   REQUIRE_EGL();
   testing::ScratchDir scratch;
   const Trial3dSpec spec = ShortSpec();
-  auto written = WriteTrial3d(spec, scratch.path());
+  auto written = WriteTrial3d(spec, Calibration2018(), scratch.path());
   ASSERT_TRUE(written.ok()) << written.status().ToString();
   const nlohmann::json truth = ReadJson(written->truth_path);
   const int first = truth["led_first_lit_frame"].get<int>();
@@ -243,7 +248,7 @@ TEST(Trial3d, TruthAndControllerLogFollowTheFormat) {
   REQUIRE_EGL();
   testing::ScratchDir scratch;
   Trial3dSpec spec = ShortSpec();
-  auto written = WriteTrial3d(spec, scratch.path());
+  auto written = WriteTrial3d(spec, Calibration2018(), scratch.path());
   ASSERT_TRUE(written.ok()) << written.status().ToString();
   const nlohmann::json truth = ReadJson(written->truth_path);
   for (const char* key :

@@ -5,6 +5,11 @@
 //   <output_dir>/<id>/video.mp4 | video.avi | video.mkv   the clip
 //   <output_dir>/<id>/controller.csv                      t_ms,rotation_rad
 //   <output_dir>/<id>/truth.json                          the answer (docs/synth.md)
+//   <output_dir>/<id>/<id>.csv                            the same test's liftoff-format log
+//
+// and, for the set, <output_dir>/manifest.json: the ok clips as a trial manifest (foot,
+// motion, liftoff log, video, ROIs, pixel scale), so `liftoff table` and `liftoff sync`
+// read 3D trials as they read 2D ones.
 //
 // Motion. sim::RunExperiment runs the paper's procedure for the trial's foot at its
 // tension point (high by default) with the ramp at theta_rate_rad_s up to
@@ -36,6 +41,8 @@
 #include <string>
 #include <vector>
 
+#include "liftoff/core/calibration.h"
+#include "liftoff/core/manifest.h"
 #include "liftoff/core/robot.h"
 #include "liftoff/core/status.h"
 #include "liftoff/synth/scene3d.h"
@@ -132,9 +139,18 @@ double EncoderQuantumRad();
 /// Fraction of the centred exposure [pts - e/2, pts + e/2] after `t_on_s`, 0 .. 1.
 double LedLitFraction(double pts_s, double exposure_s, double t_on_s);
 
+/// The 2D path's spec that writes the same test's liftoff-format log (WriteTrialLog): the
+/// LED at led_on_s, the ramp from it at theta_rate_rad_s in the simulation's sense for the
+/// foot, the bend (done before the LED in the simulation) at its target throughout, the
+/// log from the LED switch-on (no lead) to 1 s after the clip, 100 Hz.
+TrialSpec LiftoffLogSpec3d(const Trial3dSpec& spec, double duration_s);
+
 /// What WriteTrial3d produced.
 struct WrittenTrial3d {
   std::filesystem::path folder, video_path, controller_path, truth_path;
+  /// The liftoff-format log and, for an ok clip, its manifest entry (no event times).
+  std::filesystem::path liftoff_log_path;
+  std::optional<TrialRecord> manifest_entry;
   int64_t frames = 0;
   double render_seconds = 0.0, encode_seconds = 0.0;
   /// The truth as written, and its answers: "ok" or "reject"; the LED switch-on, the
@@ -147,7 +163,9 @@ struct WrittenTrial3d {
 /// Renders and writes one trial into `output_dir`/<id>/. Needs a current OpenGL context
 /// (EglContext) on the calling thread. Errors: the spec's, the simulation's, the
 /// renderer's (kUnsupported without rendering), the encoder's, kIo for files.
-Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const std::filesystem::path& output_dir);
+/// `calibration` quantises the liftoff-format log's counts.
+Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& calibration,
+                                    const std::filesystem::path& output_dir);
 
 /// The 3D CI set: short clips (LED at 2 s, liftoff ~2.5-3.5 s later, 1 s after it) with
 /// side, oblique and front views, 480p and 720p, H.264, MJPEG and a VFR-with-drops case,
@@ -156,7 +174,8 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const std::filesyst
 std::vector<Trial3dSpec> Ci3dSet();
 
 /// Writes every trial of Ci3dSet into `output_dir` on this thread (one EGL context; Mesa
-/// renders on all cores), then `set.json` (the index: id, folder, expect, render time).
+/// renders on all cores), then `manifest.json` (the ok clips) and `set.json` (the index:
+/// id, folder, expect, frames, render time).
 /// `progress` (may be empty) is called before each trial with (index, count, id).
 struct Set3dSummary {
   std::vector<WrittenTrial3d> trials;
@@ -167,7 +186,7 @@ struct Set3dSummary {
   std::string Brief() const;
 };
 Result<Set3dSummary> WriteCi3dSet(
-    const std::filesystem::path& output_dir,
+    const std::filesystem::path& output_dir, const Calibration& calibration,
     const std::function<void(int index, int count, const std::string& id)>& progress = {});
 
 }  // namespace liftoff::synth
