@@ -228,6 +228,8 @@ Status Trial3dSpec::Validate() const {
   if (flicker_hz != 100 && flicker_hz != 120) return OutOfRange(id, "flicker_hz (100 or 120)", flicker_hz, 100, 120);
   if (!(shake_px >= 0 && shake_px <= 2)) return OutOfRange(id, "shake_px", shake_px, 0, 2);
   if (!(blur_sigma_px >= 0 && blur_sigma_px <= 5)) return OutOfRange(id, "blur_sigma_px", blur_sigma_px, 0, 5);
+  if (motion_blur_samples < 1 || motion_blur_samples > 16)
+    return OutOfRange(id, "motion_blur_samples", motion_blur_samples, 1, 16);
   VideoWriterOptions writer;
   writer.codec = codec;
   writer.width_px = scene.width_px;
@@ -319,37 +321,62 @@ Result<Timing> PlanFrames(const Trial3dSpec& spec, const Motion3d& motion,
   return timing;
 }
 
-// one frame before the effects: the LED blended by its lit fraction, CV_32FC3
-cv::Mat BlendLed(SceneRenderer3d& renderer, const RobotPose3d& pose, double fraction) {
-  cv::Mat off, on;
-  if (fraction < 1) renderer.Render(pose, false).convertTo(off, CV_32FC3);
-  if (fraction > 0) {
-    cv::Mat lit = renderer.Render(pose, true);
-    renderer.AddLedGlow(lit, 1.0);
-    lit.convertTo(on, CV_32FC3);
-  }
-  if (fraction <= 0) return off;
-  if (fraction >= 1) return on;
-  return off * (1 - fraction) + on * fraction;
+// one frame before the effects, CV_32FC3: the scene averaged over the exposure's
+// sub-poses (motion blur), the LED blended by its lit fraction
+cv::Mat BlendLed(SceneRenderer3d& renderer, const std::vector<RobotPose3d>& poses, double fraction) {
+  const auto average = [&](bool led_on) {
+    cv::Mat sum;
+    for (const RobotPose3d& pose : poses) {
+      cv::Mat image = renderer.Render(pose, led_on), linear;
+      if (led_on) renderer.AddLedGlow(image, 1.0);
+      image.convertTo(linear, CV_32FC3);
+      if (sum.empty()) {
+        sum = linear;
+      } else {
+        sum += linear;
+      }
+    }
+    return cv::Mat(sum / static_cast<double>(poses.size()));
+  };
+  if (fraction <= 0) return average(false);
+  if (fraction >= 1) return average(true);
+  return cv::Mat(average(false) * (1 - fraction) + average(true) * fraction);
 }
 
 // BlendLed, remembering the last frame: the robot stands still until the ramp starts, so
 // the frames before it are one picture (rendering is deterministic: reuse is exact)
 struct FrameCache {
-  RobotPose3d pose{-1, 0};
+  std::vector<RobotPose3d> poses;
   double fraction = -1;
   cv::Mat linear;
 
-  const cv::Mat& Get(SceneRenderer3d& renderer, const RobotPose3d& at, double led_fraction) {
-    if (at.lift_m != pose.lift_m || at.vertebra_rad != pose.vertebra_rad ||
-        led_fraction != fraction) {
+  const cv::Mat& Get(SceneRenderer3d& renderer, const std::vector<RobotPose3d>& at,
+                     double led_fraction) {
+    const auto same = [](const RobotPose3d& x, const RobotPose3d& y) {
+      return x.lift_m == y.lift_m && x.vertebra_rad == y.vertebra_rad;
+    };
+    if (led_fraction != fraction || at.size() != poses.size() ||
+        !std::equal(at.begin(), at.end(), poses.begin(), same)) {
       linear = BlendLed(renderer, at, led_fraction);
-      pose = at;
+      poses = at;
       fraction = led_fraction;
     }
     return linear;
   }
 };
+
+// the poses a frame integrates: the midpoints of its exposure's equal parts (one part:
+// the pose at pts)
+std::vector<RobotPose3d> ExposurePoses(const Trial3dSpec& spec, const Motion3d& motion,
+                                       double pts_s) {
+  std::vector<RobotPose3d> poses;
+  const int parts = spec.motion_blur_samples;
+  for (int k = 0; k < parts; ++k) {
+    const double t = pts_s + spec.exposure_s * ((2.0 * k + 1) / (2.0 * parts) - 0.5);
+    poses.push_back({motion.HeightMAt(t), motion.VertebraRadAt(t)});
+  }
+  return poses;
+}
 
 nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
                          const SceneRenderer3d& renderer, const std::vector<int64_t>& pts_ns,
@@ -457,7 +484,8 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
       {"timestamp_jitter_s", spec.timestamp_jitter_s}, {"quality", spec.quality},
       {"noise_sigma", spec.noise_sigma}, {"gain", spec.gain},
       {"flicker_amplitude", spec.flicker_amplitude}, {"flicker_hz", spec.flicker_hz},
-      {"shake_px", spec.shake_px}, {"blur_sigma_px", spec.blur_sigma_px}};
+      {"shake_px", spec.shake_px}, {"blur_sigma_px", spec.blur_sigma_px},
+      {"motion_blur_samples", spec.motion_blur_samples}};
   return truth;
 }
 
@@ -506,10 +534,10 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
   for (size_t i = 0; i < timing.pts_ns.size(); ++i) {
     const int64_t started_ns = MonotonicNowNs();
     const double t = SecondsFromNs(timing.pts_ns[i]);
-    const RobotPose3d pose{motion.HeightMAt(t), motion.VertebraRadAt(t)};
     const double fraction =
         spec.led_switches_on ? LedLitFraction(t, spec.exposure_s, spec.led_on_s) : 0.0;
-    const cv::Mat frame = effects.Apply(cache.Get(*renderer, pose, fraction), i, t);
+    const cv::Mat frame =
+        effects.Apply(cache.Get(*renderer, ExposurePoses(spec, motion, t), fraction), i, t);
     shake.push_back(effects.ShakeAt(i));
     const int64_t rendered_ns = MonotonicNowNs();
     LIFTOFF_RETURN_IF_ERROR(video->Write(frame, timing.pts_ns[i]));
@@ -649,6 +677,7 @@ std::vector<Trial3dSpec> Ci3dSet() {
     s.scene.camera_height_m = 0.5;
     s.gain = 1.8;
     s.noise_sigma = 6;
+    s.motion_blur_samples = 3;  // the longest exposure: the robot blurs as it moves
     s.foot = Foot::kA;
     s.exposure_s = 1.0 / 30;
   }

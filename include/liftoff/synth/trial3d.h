@@ -23,7 +23,8 @@
 //
 // Camera. Frame i is presented at pts_i (the frame schedule and container rounding of
 // trial_writer.h's FrameScheduleNs and VideoWriter::StoredPtsNs) and integrates
-// [pts_i - e/2, pts_i + e/2]; it shows the pose at pts_i. The LED's lit fraction is the
+// [pts_i - e/2, pts_i + e/2]; it shows the pose at pts_i (or, with motion_blur_samples
+// > 1, the average of the poses at the midpoints of the exposure's equal parts). The LED's lit fraction is the
 // part of that exposure after the switch-on; a partially lit frame is off + f (on - off)
 // of the two rendered pictures (glow included), so it is exact. Then, in this order:
 // flicker (the lamp's 1 + a sin(2 pi f t) averaged over the exposure) times gain, camera
@@ -101,6 +102,9 @@ struct Trial3dSpec {
   double flicker_hz = 100.0;
   double shake_px = 0.0;
   double blur_sigma_px = 0.6;
+  /// Motion blur: the scene is averaged over this many poses at the midpoints of the
+  /// exposure's equal parts (1 .. 16; 1: the pose at pts, as the development set shows it).
+  int motion_blur_samples = 1;
 
   Status Validate() const;
 };
