@@ -8,6 +8,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -101,7 +102,11 @@ TEST(Ci3dSet, OkClipsLiftAndRejectClipsSayWhy) {
     const nlohmann::json truth = Truth(spec);
     const auto& h_mm = truth["h_mm"];
     if (truth["expect"] == "ok") {
-      EXPECT_GT(h_mm.back().get<double>(), 1.0);
+      // the foot lifts about 3 s after the LED and ends 15-21 mm up (docs/synth.md)
+      EXPECT_GE(h_mm.back().get<double>(), 15.0);
+      EXPECT_LE(h_mm.back().get<double>(), 21.0);
+      EXPECT_GT(truth["lift_minus_led_s"].get<double>(), 2.5);
+      EXPECT_LT(truth["lift_minus_led_s"].get<double>(), 3.5);
       EXPECT_GT(truth["t_lift_1mm"].get<double>(), truth["t_led_on"].get<double>());
       const size_t lifted = truth["first_lifted_frame"].get<size_t>();
       EXPECT_GT(h_mm[lifted].get<double>(), 0.0);
@@ -144,6 +149,21 @@ TEST(Ci3dSet, ManifestLogsGiveTheTruthsRotation) {
     EXPECT_NEAR(measured->liftoff_rad, truth["theta_at_lift_1mm_rad"].get<double>(),
                 0.5 * 2 * 3.14159265358979 / 48000 + 1e-6);
   }
+}
+
+// The partial LED frames and the small LED the docs describe.
+TEST(Ci3dSet, PartialLedFramesAndSmallLedAreAsDocumented) {
+  REQUIRE_SET();
+  const std::vector<Trial3dSpec> set = Ci3dSet();
+  const auto first_fraction = [](const nlohmann::json& truth) {
+    return truth["led_frac"][truth["led_first_lit_frame"].get<size_t>()].get<double>();
+  };
+  EXPECT_NEAR(first_fraction(Truth(set[0])), 0.70, 0.01);  // ci3d-01
+  EXPECT_NEAR(first_fraction(Truth(set[1])), 0.50, 0.01);  // ci3d-02
+  EXPECT_NEAR(first_fraction(Truth(set[2])), 0.28, 0.01);  // ci3d-03
+  EXPECT_NEAR(first_fraction(Truth(set[4])), 0.50, 0.01);  // ci3d-05
+  EXPECT_LT(Truth(set[6])["led_radius_px"].get<double>(), 1.5);  // ci3d-07: 1.4 px
+  EXPECT_GT(Truth(set[6])["led_radius_px"].get<double>(), 1.3);
 }
 
 TEST(Ci3dSet, HasTheVarietyItPromises) {
