@@ -715,7 +715,11 @@ Result<Set3dSummary> WriteCi3dSet(
   Set3dSummary summary;
   summary.renderer = context->description();
   const std::vector<Trial3dSpec> set = Ci3dSet();
-  nlohmann::json index = {{"set", "ci3d"}, {"renderer", summary.renderer}, {"clips", nlohmann::json::array()}};
+  nlohmann::json index = {{"format", "liftoff-synth3d-set"},
+                          {"version", 1},
+                          {"set", "ci3d"},
+                          {"renderer", summary.renderer},
+                          {"clips", nlohmann::json::array()}};
   for (size_t i = 0; i < set.size(); ++i) {
     if (progress) progress(static_cast<int>(i), static_cast<int>(set.size()), set[i].id);
     auto written = WriteTrial3d(set[i], calibration, output_dir);
