@@ -12,6 +12,9 @@
 #include "liftoff/synth/sets.h"
 #include "liftoff/synth/spec.h"
 #include "liftoff/synth/trial_writer.h"
+#if LIFTOFF_HAVE_SYNTH3D
+#include "liftoff/synth/trial3d.h"
+#endif
 
 namespace liftoff::cli {
 namespace {
@@ -80,6 +83,41 @@ int RunSet(const SynthCommand& command, const Calibration& calibration, std::ost
   return kExitOk;
 }
 
+// The 3D camera's set (trial3d.h): its own folder format, no calibration needed.
+int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
+             std::ostream& err) {
+#if LIFTOFF_HAVE_SYNTH3D
+  const auto progress = [&](int index, int count, const std::string& id) {
+    if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
+  };
+  auto summary = synth::WriteCi3dSet(command.output_dir, calibration, progress);
+  if (!summary.ok()) return ReportError(summary.status(), err);
+  for (const synth::WrittenTrial3d& written : summary->trials) {
+    const auto seconds = [](const std::optional<double>& value, int places) {
+      return value ? FormatFixed(*value, places) : std::string("-");
+    };
+    out << written.folder.filename().string() << ": " << written.frames << " frames, render "
+        << PerFrameMs(written.render_seconds, static_cast<size_t>(written.frames)) << ", encode "
+        << PerFrameMs(written.encode_seconds, static_cast<size_t>(written.frames)) << "; "
+        << written.expect << ", LED on " << seconds(written.t_led_on_s, 3) << " s, 1 mm at "
+        << seconds(written.t_lift_1mm_s, 4) << " s, " << seconds(written.theta_at_lift_1mm_rad, 4)
+        << " rad\n";
+  }
+  out << summary->Brief() << '\n' << "renderer: " << summary->renderer << '\n'
+      << "manifest: " << (command.output_dir / "manifest.json").string() << '\n'
+      << "index: " << (command.output_dir / "set.json").string() << '\n'
+      << "calibration: " << calibration.Brief() << '\n';
+  return kExitOk;
+#else
+  (void)out;
+  (void)calibration;
+  return ReportError(UnsupportedError("liftoff synth --set " + command.set_name +
+                                      ": this build has no 3D camera (needs libmujoco-dev and "
+                                      "libegl-dev at build time)"),
+                     err);
+#endif
+}
+
 }  // namespace
 
 int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) {
@@ -100,6 +138,7 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (command.set_name == "ci3d") return RunSet3d(command, *calibration, out, err);
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
                                   : RunSet(command, *calibration, out, err);
 }

@@ -19,7 +19,7 @@ namespace liftoff::cli {
 struct SynthCommand {
   /// Trial spec (JSON, docs/synth.md); relative CSV paths inside resolve against its folder.
   std::filesystem::path spec_path;
-  /// Named set: "ci" or "paper".
+  /// Named set: "ci", "paper" or "ci3d" (the 3D camera, trial3d.h).
   std::string set_name;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
