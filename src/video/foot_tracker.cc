@@ -47,11 +47,15 @@ constexpr int kTemplateFrames = 4;
 constexpr double kResidualFactor = 2.5;
 constexpr double kResidualFloor = 6.0;
 constexpr int kLostFrames = 8;
+// Largest camera shake searched between the templates and a frame, work px.
+constexpr int kShakeSearchPx = 8;
 // Largest gain change accepted for a patch (a patch that needs more is not the same thing).
 constexpr double kMaxGain = 0.5;
 // A patch is the foot's when its final rise is at least this fraction of the foot's largest
 // (patches on the foot's border with the ground move only in part).
 constexpr double kFootFraction = 0.8;
+// The foot's height per frame: this quantile of its patches' rises.
+constexpr double kFootQuantile = 0.5;
 // The fit ends where the rising curve reaches this many thresholds (at least this many
 // px): from a lossy codec, high enough to see past its lag (the model bridges the rest);
 // from a lossless one, close to the threshold, where the two-term model holds best.
@@ -71,10 +75,12 @@ constexpr double kLagBoundFactor = 1.5;
 constexpr double kFitRestS = 3.0;
 // The curve's running median for the search, s either side.
 constexpr double kSmoothHalfS = 0.15;
-// Patches that end within this of their rest are ground; the foot's patches must agree
-// with their median within 3 typical deviations plus this, px.
+// Patches that end within this of their rest are ground, px.
 constexpr double kGroundTolerancePx = 0.5;
-constexpr double kCoherencePx = 0.15;
+// The foot's patches move all the way with it: a candidate's gain against the candidates'
+// median curve must reach this fraction of the upper quartile of their gains.
+constexpr double kFullGainQuantile = 0.75;
+constexpr double kFullGainFraction = 0.9;
 // A lift is sustained for this long (and this many frames at least), s; the rest before
 // it counts as reached after kRestingS flat.
 constexpr double kSustainS = 0.5;
@@ -90,6 +96,10 @@ constexpr size_t kFewGroundPatches = 3;
 constexpr double kNoisyFraction = 0.5;
 constexpr double kWideUncertaintyS = 0.25;
 constexpr double kShortRiseThresholds = 3.0;
+// The height curve's own error, px: a registration reads a sharp edge moved by a fraction
+// of a pixel with a sawtooth error (~0.1 px on the 2D renderer's row-blended sprite), and a
+// shaken camera adds to it (0.16 px rms under 1 px-a-frame shake: foot_tracker_test).
+constexpr double kRegistrationErrorPx = 0.15;
 // Scale uncertainty assumed for an estimated px_per_mm (a fraction).
 constexpr double kEstimatedScaleFraction = 0.03;
 
@@ -190,9 +200,11 @@ struct FootTracker::Impl {
   double scale = 1;  // work px per frame px
   cv::Rect region_work_px;  // the foot region in work px
   cv::Mat work, accumulated;
-  // the templates' grey image and window, and the last frame's global shift from it (work
-  // px): a shaken camera moves every patch at once, further than one can follow alone
-  cv::Mat reference_grey, window, grey;
+  // the ground around the region as one weighted template, at full and half resolution,
+  // and the last frame's shift of it (work px): a shaken camera moves every patch at once,
+  // further than a small patch can follow alone
+  PatchTemplate ground_fine;
+  cv::Mat ground_search, ground_mask, search_scores, grey;
   cv::Point2d global_shift_px;
   int accumulated_frames = 0;
   bool initialised = false;
@@ -207,13 +219,9 @@ struct FootTracker::Impl {
   void MakeWorkImage(const cv::Mat& bgr);
   void InitialisePatches();
   void MeasurePatches();
-  // the work image in grey with the foot region filled by its mean: the ground around it,
-  // whose shift is the camera's
-  void GroundGrey(const cv::Mat& bgr, cv::Mat& out) const {
-    cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
-    const cv::Rect region = region_work_px & cv::Rect(0, 0, out.cols, out.rows);
-    out(region).setTo(cv::mean(out(region)));
-  }
+  void AccumulateTemplates(const cv::Mat& bgr);
+  void MakeGroundTemplates();
+  cv::Point2d GroundShift();
 };
 
 void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
@@ -281,11 +289,69 @@ void FootTracker::Impl::InitialisePatches() {
   }
 }
 
+// The templates: the mean of the first kTemplateFrames frames (a single frame's noise would
+// be in every sample), each moved back by the ground's shift from the first (a shaken
+// camera would blur the mean).
+void FootTracker::Impl::AccumulateTemplates(const cv::Mat& bgr) {
+  if (accumulated_frames == 0) {
+    MakeGroundTemplates();
+    accumulated = work.clone();
+  } else {
+    const cv::Point2d shift = GroundShift();
+    global_shift_px = shift;
+    const cv::Matx23d back(1, 0, -shift.x, 0, 1, -shift.y);
+    cv::Mat aligned;
+    cv::warpAffine(work, aligned, back, work.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    accumulated += aligned;
+  }
+  if (++accumulated_frames < kTemplateFrames) return;
+  work = accumulated / kTemplateFrames;
+  InitialisePatches();
+  MakeGroundTemplates();
+  global_shift_px = cv::Point2d(0, 0);
+  initialised = true;
+  accumulated.release();
+  MakeWorkImage(bgr);
+}
+
+// The ground: the work image in grey less the foot region (weight 0 there and at the
+// image's edge), whole for the sub-pixel registration, and less a border of
+// kShakeSearchPx for the search of the integer shift.
+void FootTracker::Impl::MakeGroundTemplates() {
+  cv::cvtColor(work, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat weights(grey.size(), CV_32F, cv::Scalar(1.0f));
+  weights(region_work_px & cv::Rect(0, 0, grey.cols, grey.rows)).setTo(0.0f);
+  const cv::Rect inner(1, 1, grey.cols - 2, grey.rows - 2);
+  ground_fine = internal::MakeWeightedTemplate(grey, inner, weights(inner));
+  const cv::Rect searched(kShakeSearchPx, kShakeSearchPx, grey.cols - 2 * kShakeSearchPx,
+                          grey.rows - 2 * kShakeSearchPx);
+  if (searched.width < kPatchPx || searched.height < kPatchPx) return;
+  ground_search = grey(searched).clone();
+  ground_mask = weights(searched).clone();
+}
+
+// The ground's shift since the templates, work px: the best normalised correlation over
+// every integer shift within kShakeSearchPx (textured ground is often periodic: a local
+// search would slip by a period), refined to sub-pixel with gain and offset; the last
+// frame's when it cannot be measured.
+cv::Point2d FootTracker::Impl::GroundShift() {
+  if (!ground_fine.usable || ground_search.empty()) return global_shift_px;
+  cv::cvtColor(work, grey, cv::COLOR_BGR2GRAY);
+  cv::matchTemplate(grey, ground_search, search_scores, cv::TM_CCORR_NORMED, ground_mask);
+  cv::Point best;
+  cv::minMaxLoc(search_scores, nullptr, nullptr, nullptr, &best);
+  const cv::Point2d guess(best.x - kShakeSearchPx, best.y - kShakeSearchPx);
+  const PatchMatch fine =
+      internal::RegisterPatch(ground_fine, grey, ground_fine.origin_px + guess, 10, 0.005);
+  const cv::Point2d shift = fine.origin_px - ground_fine.origin_px;
+  const bool near = std::abs(shift.x - guess.x) <= 1 && std::abs(shift.y - guess.y) <= 1;
+  return fine.ok && near ? shift : guess;
+}
+
 void FootTracker::Impl::MeasurePatches() {
-  // the whole work image's shift against the templates' (phase correlation): each patch
-  // starts from where it was, moved as much as the picture moved since the last frame
-  GroundGrey(work, grey);
-  const cv::Point2d shift = cv::phaseCorrelate(reference_grey, grey, window);
+  // each patch starts from where it was, moved as much as the ground moved since the last
+  // frame
+  const cv::Point2d shift = GroundShift();
   const cv::Point2d moved = shift - global_shift_px;
   global_shift_px = shift;
   for (TrackedPatch& patch : patches) {
@@ -366,20 +432,7 @@ Status FootTracker::Process(const Frame& frame) {
   }
   try {
     s.MakeWorkImage(bgr);
-    if (!s.initialised) {
-      // the templates: the mean of the first frames (their noise would be in every sample)
-      if (s.accumulated.empty()) s.accumulated = cv::Mat::zeros(s.work.size(), CV_32FC3);
-      s.accumulated += s.work;
-      if (++s.accumulated_frames == kTemplateFrames) {
-        s.work = s.accumulated / kTemplateFrames;
-        s.InitialisePatches();
-        s.GroundGrey(s.work, s.reference_grey);
-        cv::createHanningWindow(s.window, s.reference_grey.size(), CV_32F);
-        s.initialised = true;
-        s.accumulated.release();
-        s.MakeWorkImage(bgr);
-      }
-    }
+    if (!s.initialised) s.AccumulateTemplates(bgr);
     if (s.initialised) {
       s.MeasurePatches();
     } else {
@@ -422,20 +475,38 @@ class RiseTable {
   size_t patches_, measured_from_;
 };
 
-// Per frame, the median over `members` of value(frame, patch); NaN where fewer than
-// `min_count` are finite.
+// Quantile q (0..1, linear between order statistics) of the finite values; NaN for none.
+double FiniteQuantile(std::vector<double>& values, double q) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return kNaNd;
+  std::sort(values.begin(), values.end());
+  const double at = q * static_cast<double>(values.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(at));
+  const size_t above = std::min(values.size() - 1, below + 1);
+  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
+// Per frame, quantile q (0.5: the median) over `members` of value(frame, patch); NaN where
+// fewer than `min_count` are finite.
 template <typename Value>
-std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
-                                size_t min_count, const Value& value) {
+std::vector<double> QuantileCurve(size_t frames, const std::vector<size_t>& members,
+                                  size_t min_count, double q, const Value& value) {
   std::vector<double> curve(frames, kNaNd);
   std::vector<double> values;
   for (size_t f = 0; f < frames; ++f) {
     values.clear();
     for (size_t p : members) values.push_back(value(f, p));
-    const double median = FiniteMedian(values);
-    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = median;
+    const double quantile = FiniteQuantile(values, q);
+    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = quantile;
   }
   return curve;
+}
+
+template <typename Value>
+std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
+                                size_t min_count, const Value& value) {
+  return QuantileCurve(frames, members, min_count, 0.5, value);
 }
 
 // Median of the last `count` finite values of value(f) over frames [first, frames).
@@ -538,21 +609,30 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   for (const auto& [final_rise, p] : finals) {
     if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx) candidates.push_back(p);
   }
-  // ... and move with the others
+  // ... and move with the others, all the way: each candidate's gain against their median
+  // curve (least squares over the frames after the rest); a patch that holds some ground or
+  // shadow moves by a fraction of the foot's motion, one on something else by none of it
   const std::vector<double> common = MedianCurve(frames, candidates, 1, relative);
-  std::vector<double> deviations(candidates.size());
+  std::vector<double> gains(candidates.size(), 0.0);
   for (size_t i = 0; i < candidates.size(); ++i) {
-    std::vector<double> values;
-    for (size_t f = first; f < frames; ++f) values.push_back(std::abs(relative(f, candidates[i]) - common[f]));
-    deviations[i] = FiniteMedian(values);
+    double product = 0, norm = 0;
+    for (size_t f = first; f < frames; ++f) {
+      const double r = relative(f, candidates[i]);
+      if (!std::isfinite(r) || !std::isfinite(common[f])) continue;
+      product += r * common[f];
+      norm += common[f] * common[f];
+    }
+    gains[i] = norm > 0 ? product / norm : 0.0;
   }
-  std::vector<double> sorted = deviations;
-  const double typical = FiniteMedian(sorted);
+  std::vector<double> sorted = gains;
+  const double full = FiniteQuantile(sorted, kFullGainQuantile);
   for (size_t i = 0; i < candidates.size(); ++i) {
-    if (deviations[i] <= 3 * typical + kCoherencePx) selection.foot.push_back(candidates[i]);
+    if (gains[i] >= kFullGainFraction * full) selection.foot.push_back(candidates[i]);
   }
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
-  selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
+  // the upper quartile: a patch on the foot's border with the ground moves only in part,
+  // and a codec updates some of the foot's blocks later than others, never earlier
+  selection.height_px = QuantileCurve(frames, selection.foot, needed, kFootQuantile, relative);
   selection.quality.assign(frames, 0.0);
   for (size_t f = 0; f < frames; ++f) {
     size_t measured = 0;
@@ -845,14 +925,21 @@ bool ShowsTapeColour(const std::vector<TrackedPatch>& patches, const std::vector
   }
   if (count == 0) return false;
   const cv::Vec3d mean = sum / count;
-  const cv::Vec3d nominal = NominalTapeBgr(tape);
   const auto chroma = [](const cv::Vec3d& bgr) {
     const double grey = (bgr[0] + bgr[1] + bgr[2]) / 3;
     return bgr - cv::Vec3d(grey, grey, grey);
   };
-  const cv::Vec3d a = chroma(mean), b = chroma(nominal);
-  const double norms = cv::norm(a) * cv::norm(b);
-  return norms > 0 && a.dot(b) / norms > 0.5;
+  // the given tape's hue must be the nearest of the four, and near
+  const auto similarity = [&](Foot candidate) {
+    const cv::Vec3d a = chroma(mean), b = chroma(NominalTapeBgr(candidate));
+    const double norms = cv::norm(a) * cv::norm(b);
+    return norms > 0 ? a.dot(b) / norms : -1.0;
+  };
+  const double given = similarity(tape);
+  for (Foot other : {Foot::kA, Foot::kB, Foot::kC, Foot::kD}) {
+    if (other != tape && similarity(other) >= given) return false;
+  }
+  return given > 0.5;
 }
 
 }  // namespace
@@ -904,10 +991,17 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
     track.reference_patches_px.push_back(frame_rect(s.patches[p].templ));
     track.reference_roi_px |= track.reference_patches_px.back();
   }
-  cv::Rect foot_box;
+  // the foot's box: its patches' centres, a quarter patch beyond (a patch on the foot's
+  // edge is centred near it)
+  cv::Rect2d foot_box;
+  const double quarter_px = 0.25 * kPatchPx / s.scale;
   for (size_t p : selection.foot) {
-    track.foot_patches_px.push_back(frame_rect(s.patches[p].templ));
-    foot_box |= track.foot_patches_px.back();
+    const cv::Rect rect = frame_rect(s.patches[p].templ);
+    track.foot_patches_px.push_back(rect);
+    const cv::Point2d centre(rect.x + 0.5 * (rect.width - 1), rect.y + 0.5 * (rect.height - 1));
+    const cv::Rect2d around(centre.x - quarter_px, centre.y - quarter_px, 2 * quarter_px,
+                            2 * quarter_px);
+    foot_box = foot_box.area() > 0 ? (foot_box | around) : around;
   }
   if (selection.foot.empty()) {
     return NotFoundError("the foot never lifts: nothing in the foot region " +
@@ -975,8 +1069,11 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
       rate;
   const double scale_s =
       track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px / rate : 0.0;
-  const double uncertainty_s = std::sqrt(fit_spread * fit_spread + compression_s * compression_s +
-                                         scale_s * scale_s);
+  const double registration_s = kRegistrationErrorPx / rate;
+  const double noise_s = track.rest_noise_px / rate;  // a noisy curve crosses early or late
+  const double uncertainty_s =
+      std::sqrt(fit_spread * fit_spread + compression_s * compression_s + scale_s * scale_s +
+                registration_s * registration_s + noise_s * noise_s);
   track.above_threshold = MakeEvent(samples, crossing_s, uncertainty_s);
   track.onset = MakeEvent(samples, fit.knee_s,
                           std::max(fit.knee_s - fit.knee_low_s, fit.knee_high_s - fit.knee_s));

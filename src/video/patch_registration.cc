@@ -24,22 +24,32 @@ inline bool Sample(const cv::Mat& image, double x, double y, int channels, float
 }  // namespace
 
 PatchTemplate MakePatchTemplate(const cv::Mat& image, cv::Point origin_px, int size_px) {
+  return MakeWeightedTemplate(image, cv::Rect(origin_px, cv::Size(size_px, size_px)), cv::Mat());
+}
+
+PatchTemplate MakeWeightedTemplate(const cv::Mat& image, const cv::Rect& rect,
+                                   const cv::Mat& weights) {
   PatchTemplate patch;
-  patch.origin_px = cv::Point2d(origin_px.x, origin_px.y);
-  patch.size_px = size_px;
+  patch.origin_px = cv::Point2d(rect.x, rect.y);
+  patch.size_px = rect.width;
+  patch.width_px = rect.width;
+  patch.height_px = rect.height;
   patch.channels = image.channels();
   const int channels = patch.channels;
-  const size_t count = static_cast<size_t>(size_px * size_px * channels);
+  const size_t count = static_cast<size_t>(rect.width * rect.height * channels);
   patch.values.resize(count);
   patch.gradient_x.resize(count);
   patch.gradient_y.resize(count);
+  if (!weights.empty()) patch.weights.resize(count);
   cv::Matx44d normal = cv::Matx44d::zeros();
+  double weight_sum = 0;
   size_t k = 0;
-  for (int y = 0; y < size_px; ++y) {
-    const float* above = image.ptr<float>(origin_px.y + y - 1) + origin_px.x * channels;
-    const float* row = image.ptr<float>(origin_px.y + y) + origin_px.x * channels;
-    const float* below = image.ptr<float>(origin_px.y + y + 1) + origin_px.x * channels;
-    for (int x = 0; x < size_px; ++x) {
+  for (int y = 0; y < rect.height; ++y) {
+    const float* above = image.ptr<float>(rect.y + y - 1) + rect.x * channels;
+    const float* row = image.ptr<float>(rect.y + y) + rect.x * channels;
+    const float* below = image.ptr<float>(rect.y + y + 1) + rect.x * channels;
+    for (int x = 0; x < rect.width; ++x) {
+      const double w = weights.empty() ? 1.0 : static_cast<double>(weights.at<float>(y, x));
       for (int c = 0; c < channels; ++c, ++k) {
         const int i = x * channels + c;
         const double value = static_cast<double>(row[i]);
@@ -48,23 +58,24 @@ PatchTemplate MakePatchTemplate(const cv::Mat& image, cv::Point origin_px, int s
         patch.values[k] = static_cast<float>(value);
         patch.gradient_x[k] = static_cast<float>(gx);
         patch.gradient_y[k] = static_cast<float>(gy);
+        if (!weights.empty()) patch.weights[k] = static_cast<float>(w);
         const cv::Vec4d j(gx, gy, -value, -1.0);
-        normal += j * j.t();
+        normal += w * (j * j.t());
+        weight_sum += w;
       }
     }
   }
   patch.normal = normal;
-  patch.texture_x = normal(0, 0) / static_cast<double>(count);
-  patch.texture_y = normal(1, 1) / static_cast<double>(count);
-  // the translation must be pinned apart from brightness: its block of the inverse finite
-  double condition = 0;
+  patch.texture_x = normal(0, 0) / std::max(weight_sum, 1.0);
+  patch.texture_y = normal(1, 1) / std::max(weight_sum, 1.0);
+  // the translation must be pinned apart from brightness: its block well conditioned
   patch.normal_inverse = normal.inv(cv::DECOMP_SVD);
   const cv::Matx22d translation(normal(0, 0), normal(0, 1), normal(1, 0), normal(1, 1));
   const double trace = translation(0, 0) + translation(1, 1);
   const double det = cv::determinant(translation);
   const double disc = std::sqrt(std::max(0.0, trace * trace / 4 - det));
   const double smallest = trace / 2 - disc;
-  condition = smallest / std::max(1e-12, trace / 2 + disc);
+  const double condition = smallest / std::max(1e-12, trace / 2 + disc);
   patch.usable = smallest > 0 && condition > 1e-4 && std::isfinite(patch.normal_inverse(0, 0));
   return patch;
 }
@@ -78,27 +89,35 @@ PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::P
   for (int iteration = 1; iteration <= max_iterations; ++iteration) {
     // residual of the current estimate and its projection on the template's Jacobian
     cv::Vec4d projection(0, 0, 0, 0);
-    double sum_sq = 0;
+    double sum_sq = 0, weight_sum = 0;
     size_t k = 0;
-    for (int y = 0; y < patch.size_px; ++y) {
-      for (int x = 0; x < patch.size_px; ++x) {
+    for (int y = 0; y < patch.height_px; ++y) {
+      for (int x = 0; x < patch.width_px; ++x) {
         if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels,
                     sample.data())) {
-          match.iterations = iteration;
-          return match;
+          // a weighted template is a region: what left the image is left out; a patch that
+          // left it is lost
+          if (patch.weights.empty()) {
+            match.iterations = iteration;
+            return match;
+          }
+          k += static_cast<size_t>(channels);
+          continue;
         }
         for (int c = 0; c < channels; ++c, ++k) {
           const double value = static_cast<double>(patch.values[k]);
           const double model = (1 + match.gain) * value + match.offset;
           const double residual = static_cast<double>(sample[static_cast<size_t>(c)]) - model;
-          sum_sq += residual * residual;
+          const double w = patch.weights.empty() ? 1.0 : static_cast<double>(patch.weights[k]);
+          sum_sq += w * residual * residual;
+          weight_sum += w;
           projection += cv::Vec4d(static_cast<double>(patch.gradient_x[k]),
                                   static_cast<double>(patch.gradient_y[k]), -value, -1) *
-                        residual;
+                        (w * residual);
         }
       }
     }
-    match.residual_rms = std::sqrt(sum_sq / static_cast<double>(k));
+    match.residual_rms = std::sqrt(sum_sq / std::max(weight_sum, 1e-12));
     match.iterations = iteration;
     // image(x + d) - (1 + g) t(x) - o ~ grad t . step - t dg - do
     const cv::Vec4d step = patch.normal_inverse * projection;

@@ -19,11 +19,14 @@ namespace liftoff::video::internal {
 struct PatchTemplate {
   /// Top-left corner in the reference image, px (pixel centres at integers).
   cv::Point2d origin_px;
-  /// Side length, px; channels per pixel.
+  /// Side length (square patches), width and height, px; channels per pixel.
   int size_px = 0;
+  int width_px = 0;
+  int height_px = 0;
   int channels = 0;
-  /// size * size * channels values each: intensities and their x and y derivatives.
-  std::vector<float> values, gradient_x, gradient_y;
+  /// width * height * channels values each: intensities, their x and y derivatives, and
+  /// their weights (empty: all 1).
+  std::vector<float> values, gradient_x, gradient_y, weights;
   /// Normal matrix of (dx, dy, gain, offset), fixed per template, and its inverse.
   cv::Matx44d normal, normal_inverse;
   /// Sum of squared y derivatives, per value: how well the patch pins vertical motion.
@@ -36,6 +39,13 @@ struct PatchTemplate {
 /// Takes the patch of `image` (CV_32FC1 or CV_32FC3) at `origin_px` (integer corner) of
 /// side `size_px`. The patch and a one-pixel border must lie inside the image.
 PatchTemplate MakePatchTemplate(const cv::Mat& image, cv::Point origin_px, int size_px);
+
+/// Takes the region `rect` of `image` (CV_32FC1 or CV_32FC3), each pixel weighted by
+/// `weights` (CV_32FC1 of rect's size, >= 0; empty: all 1): a zero weight leaves a pixel
+/// out (e.g. what moves inside a region of static ground). rect and a one-pixel border must
+/// lie inside the image.
+PatchTemplate MakeWeightedTemplate(const cv::Mat& image, const cv::Rect& rect,
+                                   const cv::Mat& weights);
 
 /// Where the template was found.
 struct PatchMatch {
@@ -51,7 +61,8 @@ struct PatchMatch {
 };
 
 /// Registers `patch` in `image` (same type as the template's) starting at `guess_px`
-/// (top-left corner). Stops when a step is below `tolerance_px` or after `max_iterations`.
+/// (top-left corner). A square patch that leaves the image is not ok; a weighted region's
+/// pixels that leave it are left out. Stops when a step is below `tolerance_px` or after `max_iterations`.
 PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::Point2d guess_px,
                          int max_iterations = 8, double tolerance_px = 0.005);
 

@@ -533,7 +533,15 @@ Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
       const double x1 = crop.Map(track.foot_roi_px.x + track.foot_roi_px.width - 1.0, 0).x;
       const double xm0 = crop.Map(track.foot_center_x_px - 0.5 * track.foot_width_px, 0).x;
       const double xm1 = crop.Map(track.foot_center_x_px + 0.5 * track.foot_width_px, 0).x;
-      for (const cv::Rect& patch : track.reference_patches_px) DrawRect(crop, patch, kGrey);
+      // the ground patches where the camera's shake put them, the foot's where its rise did
+      const int shake_px = static_cast<int>(std::lround(sample.shake_y_px));
+      const int lift_px = static_cast<int>(std::lround(sample.shake_y_px - sample.rise_px));
+      for (const cv::Rect& patch : track.reference_patches_px) {
+        DrawRect(crop, patch + cv::Point(0, shake_px), kGrey);
+      }
+      for (const cv::Rect& patch : track.foot_patches_px) {
+        DrawRect(crop, patch + cv::Point(0, lift_px), kTracked);
+      }
       HLine(crop.image, crop.Map(0, lines.rest).y, x0, x1, kRest);
       HLine(crop.image, crop.Map(0, lines.threshold).y, x0, x1, kThreshold);
       HLine(crop.image, crop.Map(0, lines.tracked).y, xm0, xm1, kTracked, 2);
@@ -545,12 +553,13 @@ Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
                                                   SecondsText(sample.t_ns), "rise " + height}));
     }
     std::string heading =
-        "foot: region blue, shake references grey, rest line green, threshold red (" +
+        "foot: region blue, ground patches grey, foot patches yellow (moved by the rise), rest "
+        "green, threshold red (" +
         FormatFixed(track.threshold_px, 2) + " px";
     if (track.px_per_mm > 0) {
       heading += " = " + FormatFixed(track.threshold_px / track.px_per_mm, 2) + " mm";
     }
-    heading += "), tracked bottom yellow; rest window " + FormatSeconds(analysis.rest_from_ns) +
+    heading += "); rest window " + FormatSeconds(analysis.rest_from_ns) +
                "-" + FormatSeconds(analysis.rest_to_ns) + " s";
     parts.push_back(Row(foot_tiles, width, heading));
 

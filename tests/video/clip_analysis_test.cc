@@ -393,8 +393,9 @@ TEST(WriteVerification, TheImageNeedsOnlyTheFramesUpToLiftoff) {
   // the second decode stopped at the last frame shown: about 0.2 s after liftoff
   EXPECT_LT(report->frames_decoded, report->clip_frames);
   EXPECT_GT(report->frames_decoded, analysis->foot->above_threshold.frame_after);
-  // the foot's bottom edge, located for the drawing, where the renderer put it
-  EXPECT_NEAR(report->foot_rest_bottom_px, clips.base.truth.foot_rest_bottom_px, 1.5);
+  // the foot's bottom for the drawing (the box of the patches that moved with it, a quarter
+  // patch beyond their centres) within half a 9 px patch of where the renderer put it
+  EXPECT_NEAR(report->foot_rest_bottom_px, clips.base.truth.foot_rest_bottom_px, 4.5);
   const cv::Mat image = cv::imread(options.image_path.string());
   ASSERT_FALSE(image.empty());
   EXPECT_EQ(image.cols, options.image_width_px);
