@@ -12,6 +12,8 @@ namespace {
 
 // Least noise assumed, a fraction of the threshold (a frozen, codec-held curve has none).
 constexpr double kNoiseFloor = 0.05;
+// Least rise over the window that counts as rising, a fraction of the threshold.
+constexpr double kLeastRise = 1e-6;
 
 struct Coefficients {
   double level = 0, slope = 0, curvature = 0;
@@ -169,7 +171,10 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
     for (size_t k = 0; k < knees.size(); ++k) {
       auto [c, loss] = FitAtKnee(t_s, height, lag_free, knees[k], scale, options);
       coefficients[k] = c;
-      losses[k] = (c.slope > 0 || c.curvature > 0) ? loss : std::numeric_limits<double>::infinity();
+      // rising: by the last sample, beyond what roundoff makes of a flat series (~1e-13)
+      const double rise = Evaluate(c, knees[k], t_s.back()) - c.level;
+      losses[k] = rise > kLeastRise * options.threshold ? loss
+                                                       : std::numeric_limits<double>::infinity();
       if (losses[k] < best_loss) {
         best_loss = losses[k];
         best = k;

@@ -228,6 +228,15 @@ TEST(FitRise, FewerThanEightSamplesOrMismatchedSizesAreNotOk) {
   EXPECT_FALSE(FitRise(t_s, h, std::vector<bool>(3, true), {}).ok);
 }
 
+TEST(FitRise, FlatSeriesDoesNotRise) {
+  // a constant's least-squares slope is roundoff (1e-15 .. 1e-12), not a rise
+  const std::vector<double> t_s = Times();
+  for (const double level : {0.0, 3.0, 1234.5}) {
+    const RiseFit fit = FitRise(t_s, std::vector<double>(t_s.size(), level), {}, {});
+    EXPECT_FALSE(fit.ok) << "level " << level << ": crossing " << fit.crossing_s << " s";
+  }
+}
+
 TEST(RiseModel, IsFlatUntilTheKneeThenRisesQuadratically) {
   RiseFit fit;
   fit.knee_s = 1.0;
