@@ -213,8 +213,11 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   fit.rate_at_crossing = c.slope + 2 * c.curvature * rise_time;
 
   // every knee within a two-sigma loss increase (noise inflated for correlated residuals)
+  // (in the losses' unit: when every sample is lag-free, each weighs lag_free_weight)
   const double inflation = (1 + fit.correlation) / (1 - fit.correlation);
-  const double allowed = 4.0 * noise * noise * inflation;
+  const bool all_lag_free = std::find(lag_free.begin(), lag_free.end(), false) == lag_free.end();
+  const double unit = all_lag_free ? options.lag_free_weight : 1.0;
+  const double allowed = 4.0 * noise * noise * inflation * unit;
   fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
   fit.knee_low_s = fit.knee_high_s = fit.knee_s;
   // a knee between two grid points is within a spacing of both

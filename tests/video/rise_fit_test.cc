@@ -135,6 +135,21 @@ TEST(FitRise, CrossingIntervalCoversTheTruthUnderGaussianNoise) {
   }
 }
 
+TEST(FitRise, EverySampleLagFreeGivesTheIntervalOfEverySamplePlain) {
+  // the same weight on every sample, 1 or lag_free_weight, is the same fit and interval;
+  // at a large noise the loss-based interval, not the grid margin, has to hold the truth
+  constexpr double kNoise = 0.8;
+  double lag_free_width_s = 0, plain_width_s = 0;
+  const double lag_free = Coverage(kNoise, {}, &lag_free_width_s);
+  const double plain = Coverage(kNoise, std::vector<bool>(kSamples, false), &plain_width_s);
+  std::printf("noise %.2f: coverage %.1f %% all lag-free (width %.2f ms), %.1f %% plain "
+              "(%.2f ms)\n",
+              kNoise, 100 * lag_free, lag_free_width_s * 1e3, 100 * plain, plain_width_s * 1e3);
+  EXPECT_NEAR(lag_free_width_s, plain_width_s, 1e-9);
+  EXPECT_EQ(lag_free, plain);
+  EXPECT_GE(lag_free, 0.95);
+}
+
 TEST(FitRise, SingleTenSigmaOutlierBarelyMovesTheCrossing) {
   const Truth truth;
   const RiseFitOptions options;
