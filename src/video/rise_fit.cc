@@ -12,6 +12,8 @@ namespace {
 
 // Least noise assumed, a fraction of the threshold (a frozen, codec-held curve has none).
 constexpr double kNoiseFloor = 0.05;
+// Least rise over the window that counts as rising, a fraction of the threshold.
+constexpr double kLeastRise = 1e-6;
 
 struct Coefficients {
   double level = 0, slope = 0, curvature = 0;
@@ -169,7 +171,10 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
     for (size_t k = 0; k < knees.size(); ++k) {
       auto [c, loss] = FitAtKnee(t_s, height, lag_free, knees[k], scale, options);
       coefficients[k] = c;
-      losses[k] = (c.slope > 0 || c.curvature > 0) ? loss : std::numeric_limits<double>::infinity();
+      // rising: by the last sample, beyond what roundoff makes of a flat series (~1e-13)
+      const double rise = Evaluate(c, knees[k], t_s.back()) - c.level;
+      losses[k] = rise > kLeastRise * options.threshold ? loss
+                                                       : std::numeric_limits<double>::infinity();
       if (losses[k] < best_loss) {
         best_loss = losses[k];
         best = k;
@@ -208,8 +213,11 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   fit.rate_at_crossing = c.slope + 2 * c.curvature * rise_time;
 
   // every knee within a two-sigma loss increase (noise inflated for correlated residuals)
+  // (in the losses' unit: when every sample is lag-free, each weighs lag_free_weight)
   const double inflation = (1 + fit.correlation) / (1 - fit.correlation);
-  const double allowed = 4.0 * noise * noise * inflation;
+  const bool all_lag_free = std::find(lag_free.begin(), lag_free.end(), false) == lag_free.end();
+  const double unit = all_lag_free ? options.lag_free_weight : 1.0;
+  const double allowed = 4.0 * noise * noise * inflation * unit;
   fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
   fit.knee_low_s = fit.knee_high_s = fit.knee_s;
   // a knee between two grid points is within a spacing of both
