@@ -80,7 +80,7 @@ constexpr double kGroundTolerancePx = 0.5;
 // The foot's patches move all the way with it: a candidate's gain against the candidates'
 // median curve must reach this fraction of the upper quartile of their gains.
 constexpr double kFullGainQuantile = 0.75;
-constexpr double kFullGainFraction = 0.9;
+constexpr double kFullGainFraction = 0.5;
 // A lift is sustained for this long (and this many frames at least), s; the rest before
 // it counts as reached after kRestingS flat.
 constexpr double kSustainS = 0.5;
@@ -100,6 +100,9 @@ constexpr double kShortRiseThresholds = 3.0;
 // of a pixel with a sawtooth error (~0.1 px on the 2D renderer's row-blended sprite), and a
 // shaken camera adds to it (0.16 px rms under 1 px-a-frame shake: foot_tracker_test).
 constexpr double kRegistrationErrorPx = 0.15;
+// Below this rest noise (px) a lossless curve is crossed by a line through its own frames;
+// above it, by the fitted model (which averages over many frames).
+constexpr double kLocalCrossingNoisePx = 0.05;
 // Scale uncertainty assumed for an estimated px_per_mm (a fraction).
 constexpr double kEstimatedScaleFraction = 0.03;
 
@@ -1054,7 +1057,7 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   // is exact to noise, and a line through the frames around its crossing beats the model's
   // two terms (when it lies inside the model's interval)
   double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
-  if (search.lag_bound_px == 0) {
+  if (search.lag_bound_px == 0 && track.rest_noise_px < kLocalCrossingNoisePx) {
     const double local_s = LocalCrossingS(samples, selection.height_px, search.fit_first,
                                           search.fit_last, fit.level + track.threshold_px);
     if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
