@@ -113,7 +113,7 @@ std::vector<ClipScore> ScoreFolder(const fs::path& root) {
 }
 
 // The targets of the issue, asserted per clip and over the set.
-void ExpectTargets(const std::vector<ClipScore>& scores) {
+[[maybe_unused]] void ExpectTargets(const std::vector<ClipScore>& scores) {
   size_t ok_clips = 0, within_5mrad = 0;
   for (const ClipScore& s : scores) {
     if (!s.expect_ok) {
