@@ -37,8 +37,8 @@ constexpr double kMaxUpscale = 1.0;
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
 // Patches kept: inside the foot region, and in the margin around it.
-constexpr size_t kRegionPatches = 56;
-constexpr size_t kMarginPatches = 24;
+constexpr size_t kRegionPatches = 40;
+constexpr size_t kMarginPatches = 20;
 // Frames averaged into the templates (noise of a single frame would be in every sample).
 constexpr int kTemplateFrames = 4;
 // A patch whose residual exceeds this multiple of its running typical residual (plus a
@@ -47,8 +47,12 @@ constexpr int kTemplateFrames = 4;
 constexpr double kResidualFactor = 2.5;
 constexpr double kResidualFloor = 6.0;
 constexpr int kLostFrames = 8;
-// Largest camera shake searched between the templates and a frame, work px.
+// Largest camera shake searched between the templates and a frame, work px; a step from
+// the last frame's shift under kGroundLocalStepPx, fitting within kGroundResidualFactor of
+// the usual residual, is taken without the search.
 constexpr int kShakeSearchPx = 8;
+constexpr double kGroundLocalStepPx = 1.0;
+constexpr double kGroundResidualFactor = 1.25;
 // Largest gain change accepted for a patch (a patch that needs more is not the same thing).
 constexpr double kMaxGain = 0.5;
 // A patch is the foot's when its final rise is at least this fraction of the foot's largest
@@ -209,6 +213,7 @@ struct FootTracker::Impl {
   PatchTemplate ground_fine;
   cv::Mat ground_search, ground_mask, search_scores, grey;
   cv::Point2d global_shift_px;
+  double ground_residual = 0;  // the ground's usual residual, grey levels
   int accumulated_frames = 0;
   bool initialised = false;
   std::vector<TrackedPatch> patches;
@@ -333,13 +338,24 @@ void FootTracker::Impl::MakeGroundTemplates() {
   ground_mask = weights(searched).clone();
 }
 
-// The ground's shift since the templates, work px: the best normalised correlation over
-// every integer shift within kShakeSearchPx (textured ground is often periodic: a local
-// search would slip by a period), refined to sub-pixel with gain and offset; the last
-// frame's when it cannot be measured.
+// The ground's shift since the templates, work px: registered from the last frame's when
+// that fits as well as usual and moved under kGroundLocalStepPx; else the best normalised
+// correlation over every integer shift within kShakeSearchPx (textured ground is often
+// periodic: a local search would slip by a period), refined to sub-pixel with gain and
+// offset; the last frame's when it cannot be measured.
 cv::Point2d FootTracker::Impl::GroundShift() {
   if (!ground_fine.usable || ground_search.empty()) return global_shift_px;
   cv::cvtColor(work, grey, cv::COLOR_BGR2GRAY);
+  // from the last frame's shift: accepted when it fits as well as usual and moved little
+  const PatchMatch local = internal::RegisterPatch(
+      ground_fine, grey, ground_fine.origin_px + global_shift_px, 10, 0.005);
+  const cv::Point2d local_shift = local.origin_px - ground_fine.origin_px;
+  const bool usual = ground_residual > 0 && local.residual_rms <= kGroundResidualFactor * ground_residual;
+  if (local.ok && usual && cv::norm(local_shift - global_shift_px) < kGroundLocalStepPx) {
+    ground_residual = 0.9 * ground_residual + 0.1 * local.residual_rms;
+    return local_shift;
+  }
+  // else every integer shift
   cv::matchTemplate(grey, ground_search, search_scores, cv::TM_CCORR_NORMED, ground_mask);
   cv::Point best;
   cv::minMaxLoc(search_scores, nullptr, nullptr, nullptr, &best);
@@ -348,7 +364,10 @@ cv::Point2d FootTracker::Impl::GroundShift() {
       internal::RegisterPatch(ground_fine, grey, ground_fine.origin_px + guess, 10, 0.005);
   const cv::Point2d shift = fine.origin_px - ground_fine.origin_px;
   const bool near = std::abs(shift.x - guess.x) <= 1 && std::abs(shift.y - guess.y) <= 1;
-  return fine.ok && near ? shift : guess;
+  if (!(fine.ok && near)) return guess;
+  ground_residual = ground_residual > 0 ? 0.9 * ground_residual + 0.1 * fine.residual_rms
+                                        : fine.residual_rms;
+  return shift;
 }
 
 void FootTracker::Impl::MeasurePatches() {

@@ -21,6 +21,75 @@ inline bool Sample(const cv::Mat& image, double x, double y, int channels, float
   return true;
 }
 
+// Whether every sample of the patch at `origin` has its four neighbours in the image.
+bool Inside(const PatchTemplate& patch, const cv::Mat& image, cv::Point2d origin) {
+  if (!(origin.x >= 0 && origin.y >= 0)) return false;
+  const double x0 = std::floor(origin.x), y0 = std::floor(origin.y);
+  return x0 + patch.width_px <= image.cols - 1 && y0 + patch.height_px <= image.rows - 1;
+}
+
+// One Gauss-Newton pass's sums, the patch wholly inside: every sample has the same
+// sub-pixel offset, so the bilinear weights are computed once.
+void AccumulateInside(const PatchTemplate& patch, const cv::Mat& image, const PatchMatch& match,
+                      cv::Vec4d& projection, double& sum_sq, double& weight_sum) {
+  const int channels = patch.channels;
+  const int x0 = static_cast<int>(std::floor(match.origin_px.x));
+  const int y0 = static_cast<int>(std::floor(match.origin_px.y));
+  const float fx = static_cast<float>(match.origin_px.x - x0);
+  const float fy = static_cast<float>(match.origin_px.y - y0);
+  const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+  const float gain = static_cast<float>(1 + match.gain), offset = static_cast<float>(match.offset);
+  const bool weighted = !patch.weights.empty();
+  double p0 = 0, p1 = 0, p2 = 0, p3 = 0;
+  size_t k = 0;
+  for (int y = 0; y < patch.height_px; ++y) {
+    const float* r0 = image.ptr<float>(y0 + y) + x0 * channels;
+    const float* r1 = image.ptr<float>(y0 + y + 1) + x0 * channels;
+    const int count = patch.width_px * channels;
+    for (int i = 0; i < count; ++i, ++k) {
+      const float sample = w00 * r0[i] + w01 * r0[i + channels] + w10 * r1[i] + w11 * r1[i + channels];
+      const float value = patch.values[k];
+      const float w = weighted ? patch.weights[k] : 1.0f;
+      const float residual = sample - (gain * value + offset);
+      const float wr = w * residual;
+      sum_sq += static_cast<double>(wr * residual);
+      weight_sum += static_cast<double>(w);
+      p0 += static_cast<double>(patch.gradient_x[k] * wr);
+      p1 += static_cast<double>(patch.gradient_y[k] * wr);
+      p2 -= static_cast<double>(value * wr);
+      p3 -= static_cast<double>(wr);
+    }
+  }
+  projection = cv::Vec4d(p0, p1, p2, p3);
+}
+
+// The same sums for a weighted region partly outside the image: what left it is left out.
+void AccumulateClipped(const PatchTemplate& patch, const cv::Mat& image, const PatchMatch& match,
+                       std::vector<float>& sample, cv::Vec4d& projection, double& sum_sq,
+                       double& weight_sum) {
+  const int channels = patch.channels;
+  size_t k = 0;
+  for (int y = 0; y < patch.height_px; ++y) {
+    for (int x = 0; x < patch.width_px; ++x) {
+      if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels, sample.data())) {
+        k += static_cast<size_t>(channels);
+        continue;
+      }
+      for (int c = 0; c < channels; ++c, ++k) {
+        const double value = static_cast<double>(patch.values[k]);
+        const double model = (1 + match.gain) * value + match.offset;
+        const double residual = static_cast<double>(sample[static_cast<size_t>(c)]) - model;
+        const double w = static_cast<double>(patch.weights[k]);
+        sum_sq += w * residual * residual;
+        weight_sum += w;
+        projection += cv::Vec4d(static_cast<double>(patch.gradient_x[k]),
+                                static_cast<double>(patch.gradient_y[k]), -value, -1) *
+                      (w * residual);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 PatchTemplate MakePatchTemplate(const cv::Mat& image, cv::Point origin_px, int size_px) {
@@ -90,32 +159,13 @@ PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::P
     // residual of the current estimate and its projection on the template's Jacobian
     cv::Vec4d projection(0, 0, 0, 0);
     double sum_sq = 0, weight_sum = 0;
-    size_t k = 0;
-    for (int y = 0; y < patch.height_px; ++y) {
-      for (int x = 0; x < patch.width_px; ++x) {
-        if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels,
-                    sample.data())) {
-          // a weighted template is a region: what left the image is left out; a patch that
-          // left it is lost
-          if (patch.weights.empty()) {
-            match.iterations = iteration;
-            return match;
-          }
-          k += static_cast<size_t>(channels);
-          continue;
-        }
-        for (int c = 0; c < channels; ++c, ++k) {
-          const double value = static_cast<double>(patch.values[k]);
-          const double model = (1 + match.gain) * value + match.offset;
-          const double residual = static_cast<double>(sample[static_cast<size_t>(c)]) - model;
-          const double w = patch.weights.empty() ? 1.0 : static_cast<double>(patch.weights[k]);
-          sum_sq += w * residual * residual;
-          weight_sum += w;
-          projection += cv::Vec4d(static_cast<double>(patch.gradient_x[k]),
-                                  static_cast<double>(patch.gradient_y[k]), -value, -1) *
-                        (w * residual);
-        }
-      }
+    if (Inside(patch, image, match.origin_px)) {
+      AccumulateInside(patch, image, match, projection, sum_sq, weight_sum);
+    } else if (patch.weights.empty()) {
+      match.iterations = iteration;  // a patch that left the image is lost
+      return match;
+    } else {
+      AccumulateClipped(patch, image, match, sample, projection, sum_sq, weight_sum);
     }
     match.residual_rms = std::sqrt(sum_sq / std::max(weight_sum, 1e-12));
     match.iterations = iteration;
