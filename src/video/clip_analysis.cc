@@ -263,6 +263,8 @@ json TimingJson(const FrameTimingReport& timing) {
           {"fps", timing.fps > 0 ? json(timing.fps) : json()},
           {"codec", timing.codec_fourcc},
           {"lossless_codec", timing.lossless_codec},
+          {"keyframes", timing.keyframes},
+          {"keyframes_known", timing.keyframes_known},
           {"dropped_frames", timing.dropped_frames},
           {"repaired_frames", timing.repaired_frames},
           {"irregular_frames", timing.irregular_frames},
@@ -381,11 +383,16 @@ json ClipAnalysis::ToJson() const {
       {"wall_s", wall_seconds},
   };
   if (foot) {
-    json patches = json::array();
+    json patches = json::array(), foot_patches = json::array();
     for (const cv::Rect& patch : foot->reference_patches_px) patches.push_back(RectJson(patch));
+    for (const cv::Rect& patch : foot->foot_patches_px) foot_patches.push_back(RectJson(patch));
     document["foot"] = {
         {"roi_px", RectJson(foot->foot_roi_px)},
         {"reference_patches_px", patches},
+        {"foot_patches_px", foot_patches},
+        {"low_confidence", foot->low_confidence},
+        {"fit_frames", {foot->fit_first_frame, foot->fit_last_frame}},
+        {"fit_noise_px", foot->fit_noise_px},
         {"located_by_tape", foot->located_by_tape},
         {"center_x_px", foot->foot_center_x_px},
         {"width_px", foot->foot_width_px},

@@ -37,8 +37,8 @@ constexpr double kMaxUpscale = 1.0;
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
 // Patches kept: inside the foot region, and in the margin around it.
-constexpr size_t kRegionPatches = 40;
-constexpr size_t kMarginPatches = 20;
+constexpr size_t kRegionPatches = 56;
+constexpr size_t kMarginPatches = 24;
 // Frames averaged into the templates (noise of a single frame would be in every sample).
 constexpr int kTemplateFrames = 4;
 // A patch whose residual exceeds this multiple of its running typical residual (plus a
