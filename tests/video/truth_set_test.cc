@@ -112,25 +112,33 @@ std::vector<ClipScore> ScoreFolder(const fs::path& root) {
   return scores;
 }
 
-// The targets of the issue, asserted per clip and over the set.
-[[maybe_unused]] void ExpectTargets(const std::vector<ClipScore>& scores) {
+// The targets of the issue, asserted per clip and over the set: the rejects not found; on
+// every ok clip the LED within half a frame and the truth inside the interval; with
+// `rotation_targets`, the rotation within 0.01 rad in every ok clip and within 0.005 rad in
+// at least 90 % of them. Returns the number of ok clips.
+size_t ExpectTargets(const std::vector<ClipScore>& scores, bool rotation_targets) {
   size_t ok_clips = 0, within_5mrad = 0;
   for (const ClipScore& s : scores) {
     if (!s.expect_ok) {
       EXPECT_EQ(s.status.code(), StatusCode::kNotFound) << s.id << ": " << s.status.ToString();
       continue;
     }
-    ASSERT_TRUE(s.status.ok()) << s.id << ": " << s.status.ToString();
+    EXPECT_TRUE(s.status.ok()) << s.id << ": " << s.status.ToString();
+    if (!s.status.ok()) continue;
     ++ok_clips;
     EXPECT_LE(std::abs(s.led_error_frames), 0.5) << s.id;
-    EXPECT_LE(std::abs(s.rotation_error_rad), 0.01) << s.id;
     EXPECT_TRUE(s.truth_inside) << s.id << ": error " << s.liftoff_error_ms << " ms, +- "
                                 << s.interval_uncertainty_ms << " ms";
+    if (rotation_targets) {
+      EXPECT_LE(std::abs(s.rotation_error_rad), 0.01) << s.id;
+    }
     if (std::abs(s.rotation_error_rad) <= 0.005) ++within_5mrad;
   }
-  ASSERT_GT(ok_clips, 0u);
-  EXPECT_GE(static_cast<double>(within_5mrad), 0.9 * static_cast<double>(ok_clips))
-      << within_5mrad << " of " << ok_clips << " clips within 0.005 rad";
+  if (rotation_targets && ok_clips > 0) {
+    EXPECT_GE(static_cast<double>(within_5mrad), 0.9 * static_cast<double>(ok_clips))
+        << within_5mrad << " of " << ok_clips << " clips within 0.005 rad";
+  }
+  return ok_clips;
 }
 
 const ClipScore* Find(const std::vector<ClipScore>& scores, const std::string& prefix) {
@@ -149,18 +157,7 @@ TEST(Video3dCiSet, LedRejectsAndIntervalsHold) {
   const fs::path root = LIFTOFF_CI3D_SET_DIR;
   if (!fs::exists(root / "set.json")) GTEST_SKIP() << root << " was not rendered (no headless GL)";
   const std::vector<ClipScore> scores = ScoreFolder(root);
-  size_t ok_clips = 0;
-  for (const ClipScore& s : scores) {
-    if (!s.expect_ok) {
-      EXPECT_EQ(s.status.code(), StatusCode::kNotFound) << s.id << ": " << s.status.ToString();
-      continue;
-    }
-    ASSERT_TRUE(s.status.ok()) << s.id << ": " << s.status.ToString();
-    ++ok_clips;
-    EXPECT_LE(std::abs(s.led_error_frames), 0.5) << s.id;
-    EXPECT_TRUE(s.truth_inside) << s.id << ": error " << s.liftoff_error_ms << " ms, +- "
-                                << s.interval_uncertainty_ms << " ms";
-  }
+  const size_t ok_clips = ExpectTargets(scores, /*rotation_targets=*/false);
   EXPECT_EQ(ok_clips, 8u);
   const ClipScore* led_never_on = Find(scores, "ci3d-09");
   const ClipScore* never_lifts = Find(scores, "ci3d-10");
@@ -175,7 +172,7 @@ TEST(VideoDevSet, EveryClipMeetsTheTargets) {
   const fs::path root = fs::path(LIFTOFF_SHARED_DIR) / "video-dev";
   if (!fs::exists(root)) GTEST_SKIP() << root << " is absent (a fresh clone has no ../shared)";
   const std::vector<ClipScore> scores = ScoreFolder(root);
-  ExpectTargets(scores);
+  EXPECT_EQ(ExpectTargets(scores, /*rotation_targets=*/true), 11u);
   // the two reject clips, each with its own error
   const ClipScore* led_never_on = Find(scores, "d11");
   const ClipScore* never_lifts = Find(scores, "d12");
