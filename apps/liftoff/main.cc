@@ -50,7 +50,7 @@ std::vector<CLI::Option*> AddClipFlags(CLI::App* app, ClipChoice& clip) {
                                     "Foot region x,y,w,h in pixels: the foot at rest and room "
                                     "above it (without it: the LED only)"));
   options.push_back(
-      app->add_option("--foot", clip.foot, "Track this foot's tape colour too: A, B, C or D"));
+      app->add_option("--foot", clip.foot, "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
   options.push_back(
       app->add_option("--px-per-mm", clip.px_per_mm,
                       "Image scale at the foot, px per mm (default: from the foot's width)"));
