@@ -220,17 +220,18 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   const double allowed = 4.0 * noise * noise * inflation * unit;
   fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
   fit.knee_low_s = fit.knee_high_s = fit.knee_s;
-  // a knee between two grid points is within a spacing of both
-  const double half_spacing = 0.5 * (t_s.back() - t_s.front()) / static_cast<double>(n - 1);
-  const double spacing = half_spacing;  // the grid holds the samples and their midpoints
+  // the knee grid holds the samples and their midpoints: its step is half the samples'
+  // mean spacing, and a knee between two grid points is within a step of both; the bounds
+  // get two steps (one sample spacing) of margin
+  const double grid_step = 0.5 * (t_s.back() - t_s.front()) / static_cast<double>(n - 1);
   for (size_t k = 0; k < knees.size(); ++k) {
     if (!(losses[k] - losses[best] <= allowed)) continue;
     const double crossing = knees[k] + TimeToRise(coefficients[k], options.threshold);
     if (!std::isfinite(crossing)) continue;
-    fit.crossing_low_s = std::min(fit.crossing_low_s, crossing - 2 * spacing);
-    fit.crossing_high_s = std::max(fit.crossing_high_s, crossing + 2 * spacing);
-    fit.knee_low_s = std::min(fit.knee_low_s, knees[k] - 2 * spacing);
-    fit.knee_high_s = std::max(fit.knee_high_s, knees[k] + 2 * spacing);
+    fit.crossing_low_s = std::min(fit.crossing_low_s, crossing - 2 * grid_step);
+    fit.crossing_high_s = std::max(fit.crossing_high_s, crossing + 2 * grid_step);
+    fit.knee_low_s = std::min(fit.knee_low_s, knees[k] - 2 * grid_step);
+    fit.knee_high_s = std::max(fit.knee_high_s, knees[k] + 2 * grid_step);
   }
   fit.crossing_middle_s = 0.5 * (fit.crossing_low_s + fit.crossing_high_s);
   return fit;

@@ -3,7 +3,7 @@
 // A foot at rest, then lifted: h(t) = level for t < knee, and
 //   h(t) = level + slope (t - knee) + curvature (t - knee)^2      for t >= knee,
 // slope and curvature >= 0 (a lift goes on rising). The knee is searched over a grid (every
-// sample time in the window, refined to a tenth of the spacing around the best); for each
+// sample time in the window, and the midpoints between them); for each
 // knee the other three are a linear least-squares fit with the sign constraints, weighted
 // by a Huber loss (iteratively reweighted) so that a few frames off the curve (a codec's
 // step, a one-frame bump) do not move it, and optionally asymmetric after the knee (a
