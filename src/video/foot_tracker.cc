@@ -107,6 +107,8 @@ constexpr double kRegistrationErrorPx = 0.15;
 // Below this rest noise (px) a lossless curve is crossed by a line through its own frames;
 // above it, by the fitted model (which averages over many frames).
 constexpr double kLocalCrossingNoisePx = 0.05;
+// The largest uncertainty reported, s (a day: a bound on the arithmetic, not a result).
+constexpr double kLongestUncertaintyS = 86400.0;
 // Scale uncertainty assumed for an estimated px_per_mm (a fraction).
 constexpr double kEstimatedScaleFraction = 0.03;
 
@@ -1096,7 +1098,9 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   const double uncertainty_s =
       std::sqrt(fit_spread * fit_spread + compression_s * compression_s + scale_s * scale_s +
                 registration_s * registration_s + noise_s * noise_s);
-  track.above_threshold = MakeEvent(samples, crossing_s, uncertainty_s);
+  // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
+  track.above_threshold =
+      MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
   track.onset = MakeEvent(samples, fit.knee_s,
                           std::max(fit.knee_s - fit.knee_low_s, fit.knee_high_s - fit.knee_s));
   track.fit_first_frame = samples[search.fit_first].frame_index;
