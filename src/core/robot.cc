@@ -18,6 +18,16 @@ std::string_view FootTapeColour(Foot foot) {
   return kColours[static_cast<size_t>(foot)];
 }
 
+std::array<double, 3> FootTapeBgr(Foot foot) {
+  static constexpr std::array<std::array<double, 3>, 4> kBgr = {{
+      {200, 80, 20},   // blue
+      {20, 140, 255},  // orange
+      {160, 40, 130},  // purple
+      {30, 30, 210},   // red
+  }};
+  return kBgr[static_cast<size_t>(foot)];
+}
+
 std::optional<Foot> ParseFoot(std::string_view text) {
   for (Foot foot : kAllFeet) {
     if (text == FootName(foot)) return foot;

@@ -3,6 +3,7 @@
 #include "liftoff/synth/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -10,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "liftoff/core/random.h"
+#include "liftoff/core/robot.h"
 #include "liftoff/core/time.h"
 
 namespace liftoff::synth {
@@ -267,13 +269,8 @@ void ApplyVignette(cv::Mat& canvas, int margin_px, const Camera& camera) {
 // feet and legs
 
 cv::Vec3d TapeBgr(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return {200, 80, 20};   // blue
-    case Foot::kB: return {20, 140, 255};  // orange
-    case Foot::kC: return {160, 40, 130};  // purple
-    case Foot::kD: return {30, 30, 210};   // red
-  }
-  return {};
+  const std::array<double, 3> bgr = FootTapeBgr(foot);
+  return {bgr[0], bgr[1], bgr[2]};
 }
 
 struct FootShape {

@@ -1,6 +1,7 @@
 #include "liftoff/video/foot_tracker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -31,8 +32,6 @@ using internal::RectText;
 // no more than small ones).
 constexpr double kMarginFraction = 0.3;
 constexpr double kWorkRegionPx = 64.0;
-// The work image is never enlarged (enlarging a small region was measured worse).
-constexpr double kMaxUpscale = 1.0;
 // Patch side in work px, and the spacing of candidate patches.
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
@@ -58,8 +57,6 @@ constexpr double kMaxGain = 0.5;
 // A patch is the foot's when its final rise is at least this fraction of the foot's largest
 // (patches on the foot's border with the ground move only in part).
 constexpr double kFootFraction = 0.8;
-// The foot's height per frame: this quantile of its patches' rises.
-constexpr double kFootQuantile = 0.5;
 // The fit ends where the rising curve reaches this many thresholds (at least this many
 // px): from a lossy codec, high enough to see past its lag (the model bridges the rest);
 // from a lossless one, close to the threshold, where the two-term model holds best.
@@ -209,9 +206,9 @@ struct FootTracker::Impl {
   double scale = 1;  // work px per frame px
   cv::Rect region_work_px;  // the foot region in work px
   cv::Mat work, accumulated;
-  // the ground around the region as one weighted template, at full and half resolution,
-  // and the last frame's shift of it (work px): a shaken camera moves every patch at once,
-  // further than a small patch can follow alone
+  // the ground around the region as one weighted template, and without a border as the
+  // template of the integer search; the last frame's shift of it (work px): a shaken camera
+  // moves every patch at once, further than a small patch can follow alone
   PatchTemplate ground_fine;
   cv::Mat ground_search, ground_mask, search_scores, grey;
   cv::Point2d global_shift_px;
@@ -241,7 +238,8 @@ void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
   work_px = cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
                      roi.height + 2 * margin_y) &
             cv::Rect(0, 0, size.width, size.height);
-  scale = std::min(kMaxUpscale, kWorkRegionPx / std::min(roi.width, roi.height));
+  // never enlarged (enlarging a small region was measured worse)
+  scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
   const auto to_work = [&](int v, int origin) {
     return static_cast<int>(std::lround((v - origin) * scale));
   };
@@ -254,8 +252,6 @@ void FootTracker::Impl::MakeWorkImage(const cv::Mat& bgr) {
   cv::Mat crop = bgr(work_px), scaled;
   if (scale < 1) {
     cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
-  } else if (scale > 1) {
-    cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_LINEAR);
   } else {
     scaled = crop;
   }
@@ -487,7 +483,6 @@ class RiseTable {
   RiseTable(const std::vector<float>& rises, size_t patches, size_t measured_from)
       : rises_(rises), patches_(patches), measured_from_(measured_from) {}
   size_t patches() const { return patches_; }
-  size_t measured_from() const { return measured_from_; }
   double Raw(size_t frame, size_t patch) const {
     if (frame < measured_from_) return kNaNd;
     const size_t at = (frame - measured_from_) * patches_ + patch;
@@ -511,26 +506,20 @@ double FiniteQuantile(std::vector<double>& values, double q) {
   return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
 }
 
-// Per frame, quantile q (0.5: the median) over `members` of value(frame, patch); NaN where
-// fewer than `min_count` are finite.
+// Per frame, the median over `members` of value(frame, patch); NaN where fewer than
+// `min_count` are finite.
 template <typename Value>
-std::vector<double> QuantileCurve(size_t frames, const std::vector<size_t>& members,
-                                  size_t min_count, double q, const Value& value) {
+std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
+                                size_t min_count, const Value& value) {
   std::vector<double> curve(frames, kNaNd);
   std::vector<double> values;
   for (size_t f = 0; f < frames; ++f) {
     values.clear();
     for (size_t p : members) values.push_back(value(f, p));
-    const double quantile = FiniteQuantile(values, q);
-    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = quantile;
+    const double median = FiniteMedian(values);
+    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = median;
   }
   return curve;
-}
-
-template <typename Value>
-std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
-                                size_t min_count, const Value& value) {
-  return QuantileCurve(frames, members, min_count, 0.5, value);
 }
 
 // Median of the last `count` finite values of value(f) over frames [first, frames).
@@ -654,9 +643,7 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
     if (gains[i] >= kFullGainFraction * full) selection.foot.push_back(candidates[i]);
   }
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
-  // the upper quartile: a patch on the foot's border with the ground moves only in part,
-  // and a codec updates some of the foot's blocks later than others, never earlier
-  selection.height_px = QuantileCurve(frames, selection.foot, needed, kFootQuantile, relative);
+  selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
   selection.quality.assign(frames, 0.0);
   for (size_t f = 0; f < frames; ++f) {
     size_t measured = 0;
@@ -837,7 +824,7 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   if (search.fit.ok) {
     for (double* t : {&search.fit.knee_s, &search.fit.knee_low_s, &search.fit.knee_high_s,
                       &search.fit.crossing_s, &search.fit.crossing_low_s,
-                      &search.fit.crossing_high_s}) {
+                      &search.fit.crossing_high_s, &search.fit.crossing_middle_s}) {
       *t += origin_s;
     }
   } else {
@@ -845,7 +832,6 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                        FormatSeconds(samples[start].t_ns, 3) + " and " +
                        FormatSeconds(samples[cut].t_ns, 3) + " s";
   }
-  if (search.fit.ok) search.fit.crossing_middle_s += origin_s;
   search.fit_first = start;
   search.fit_last = std::max(cut, cut_with_key);
   return search;
@@ -886,23 +872,8 @@ TimedEvent MakeEvent(const std::vector<HeightSample>& samples, double t_s, doubl
   return event;
 }
 
-}  // namespace
-
-namespace {
-
 std::string PatchCount(size_t count) {
   return std::to_string(count) + (count == 1 ? " patch" : " patches");
-}
-
-// The nominal tape colours of the synthetic scenes, BGR (A blue, B orange, C purple, D red).
-cv::Vec3d NominalTapeBgr(Foot foot) {
-  switch (foot) {
-    case Foot::kA: return {200, 80, 20};
-    case Foot::kB: return {20, 140, 255};
-    case Foot::kC: return {160, 40, 130};
-    case Foot::kD: return {30, 30, 210};
-  }
-  return {128, 128, 128};
 }
 
 // Warnings where the evidence is weak; low_confidence when any is.
@@ -955,12 +926,13 @@ bool ShowsTapeColour(const std::vector<TrackedPatch>& patches, const std::vector
   };
   // the given tape's hue must be the nearest of the four, and near
   const auto similarity = [&](Foot candidate) {
-    const cv::Vec3d a = chroma(mean), b = chroma(NominalTapeBgr(candidate));
+    const std::array<double, 3> tape_bgr = FootTapeBgr(candidate);
+    const cv::Vec3d a = chroma(mean), b = chroma(cv::Vec3d(tape_bgr[0], tape_bgr[1], tape_bgr[2]));
     const double norms = cv::norm(a) * cv::norm(b);
     return norms > 0 ? a.dot(b) / norms : -1.0;
   };
   const double given = similarity(tape);
-  for (Foot other : {Foot::kA, Foot::kB, Foot::kC, Foot::kD}) {
+  for (Foot other : kAllFeet) {
     if (other != tape && similarity(other) >= given) return false;
   }
   return given > 0.5;

@@ -65,20 +65,21 @@ void AccumulateInside(const PatchTemplate& patch, const cv::Mat& image, const Pa
 
 // The same sums for a weighted region partly outside the image: what left it is left out.
 void AccumulateClipped(const PatchTemplate& patch, const cv::Mat& image, const PatchMatch& match,
-                       std::vector<float>& sample, cv::Vec4d& projection, double& sum_sq,
+                       cv::Vec4d& projection, double& sum_sq,
                        double& weight_sum) {
   const int channels = patch.channels;
+  cv::Vec4f sample;  // CV_32FC1 or CV_32FC3 (MakeWeightedTemplate)
   size_t k = 0;
   for (int y = 0; y < patch.height_px; ++y) {
     for (int x = 0; x < patch.width_px; ++x) {
-      if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels, sample.data())) {
+      if (!Sample(image, match.origin_px.x + x, match.origin_px.y + y, channels, sample.val)) {
         k += static_cast<size_t>(channels);
         continue;
       }
       for (int c = 0; c < channels; ++c, ++k) {
         const double value = static_cast<double>(patch.values[k]);
         const double model = (1 + match.gain) * value + match.offset;
-        const double residual = static_cast<double>(sample[static_cast<size_t>(c)]) - model;
+        const double residual = static_cast<double>(sample[c]) - model;
         const double w = static_cast<double>(patch.weights[k]);
         sum_sq += w * residual * residual;
         weight_sum += w;
@@ -153,8 +154,6 @@ PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::P
                          int max_iterations, double tolerance_px) {
   PatchMatch match;
   match.origin_px = guess_px;
-  const int channels = patch.channels;
-  std::vector<float> sample(static_cast<size_t>(channels));
   for (int iteration = 1; iteration <= max_iterations; ++iteration) {
     // residual of the current estimate and its projection on the template's Jacobian
     cv::Vec4d projection(0, 0, 0, 0);
@@ -165,7 +164,7 @@ PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::P
       match.iterations = iteration;  // a patch that left the image is lost
       return match;
     } else {
-      AccumulateClipped(patch, image, match, sample, projection, sum_sq, weight_sum);
+      AccumulateClipped(patch, image, match, projection, sum_sq, weight_sum);
     }
     match.residual_rms = std::sqrt(sum_sq / std::max(weight_sum, 1e-12));
     match.iterations = iteration;

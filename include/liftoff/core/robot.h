@@ -20,6 +20,9 @@ std::string_view FootName(Foot foot);
 std::string_view FootPosition(Foot foot);
 /// Colour of the foot's tape on the hardware: "blue", "orange", "purple", "red".
 std::string_view FootTapeColour(Foot foot);
+/// That colour as the synthetic scenes draw it and the video check expects it: blue,
+/// green, red, 0..255.
+std::array<double, 3> FootTapeBgr(Foot foot);
 /// Parses "A".."D" (exact, upper case); nullopt otherwise.
 std::optional<Foot> ParseFoot(std::string_view text);
 /// The foot diagonally opposite: A <-> D, B <-> C (the pair a twist of the spine raises).
