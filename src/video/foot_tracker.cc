@@ -193,6 +193,8 @@ struct TrackedPatch {
   bool in_region = false;
 };
 
+struct PatchSelection;  // which patches are the foot and the ground (at the end)
+
 }  // namespace
 
 struct FootTracker::Impl {
@@ -229,6 +231,7 @@ struct FootTracker::Impl {
   void AccumulateTemplates(const cv::Mat& bgr);
   void MakeGroundTemplates();
   cv::Point2d GroundShift();
+  cv::Rect2d PlacePatches(const PatchSelection& selection, FootTrack& track) const;
 };
 
 void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
@@ -700,17 +703,12 @@ double LagBoundPx(const std::vector<double>& height, size_t first, size_t last) 
   return std::max(kMinLagPx, kLagBoundFactor * (largest - (std::isfinite(typical) ? typical : 0.0)));
 }
 
-LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
-                          const std::vector<double>& height, size_t first, double threshold_px,
-                          double rest_noise_px, bool lossy) {
-  LiftoffSearch search;
-  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
-  for (size_t f = first; f < smooth.size(); ++f) {
-    if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
-  }
-  // the rise for good: the first frame from which the smoothed curve stays above the
-  // threshold for kSustainS (or to the clip's end, if that is at least kSustainFrames frames
-  // and two thresholds up); the cut: where it then reaches the fit's top
+// The rise for good: the first frame from which the smoothed curve stays above the
+// threshold for kSustainS (or to the clip's end, if that is at least kSustainFrames frames
+// and two thresholds up); the cut: where it then reaches the fit's top. smooth.size() when
+// there is none.
+size_t FindCut(const std::vector<HeightSample>& samples, const std::vector<double>& smooth,
+               size_t first, double threshold_px, bool lossy) {
   const size_t sustain = std::max<size_t>(kSustainFrames, FramesIn(samples, kSustainS));
   size_t rise = smooth.size();
   for (size_t f = first; f < smooth.size() && rise == smooth.size(); ++f) {
@@ -727,42 +725,30 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                             highest >= 2 * threshold_px;
     if (above >= sustain || to_the_end) rise = f;
   }
-  size_t cut = smooth.size();
-  if (rise < smooth.size()) {
-    double highest = 0;
-    for (size_t f = rise; f < smooth.size(); ++f) {
-      if (std::isfinite(smooth[f])) highest = std::max(highest, smooth[f]);
-    }
-    const double top =
-        std::min(lossy ? std::max(kFitTopThresholdsLossy * threshold_px, kFitTopPxLossy)
-                       : std::max(kFitTopThresholdsLossless * threshold_px, kFitTopPxLossless),
-                 0.8 * highest);
-    for (size_t f = rise; f < smooth.size() && cut == smooth.size(); ++f) {
-      if (smooth[f] >= top) cut = f;
-    }
+  if (rise == smooth.size()) return rise;
+  double highest = 0;
+  for (size_t f = rise; f < smooth.size(); ++f) {
+    if (std::isfinite(smooth[f])) highest = std::max(highest, smooth[f]);
   }
-  if (cut == smooth.size()) {
-    search.not_found = "the foot never lifts: its largest rise is " +
-                       FormatFixed(search.max_rise_px, 2) + " px above rest, below the " +
-                       FormatFixed(threshold_px, 2) + " px threshold held for " +
-                       FormatFixed(kSustainS, 1) + " s";
-    return search;
+  const double top =
+      std::min(lossy ? std::max(kFitTopThresholdsLossy * threshold_px, kFitTopPxLossy)
+                     : std::max(kFitTopThresholdsLossless * threshold_px, kFitTopPxLossless),
+               0.8 * highest);
+  for (size_t f = rise; f < smooth.size(); ++f) {
+    if (smooth[f] >= top) return f;
   }
-  size_t cut_with_key = 0;
-  // a key frame soon after the cut shows the foot without lag: fit up to it
-  for (size_t f = cut + 1; f < smooth.size(); ++f) {
-    if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
-    if (lossy && samples[f].keyframe && std::isfinite(height[f])) {
-      cut_with_key = f;
-      break;
-    }
-  }
-  // back from the cut: the climb, then up to kFitRestS of rest (a step in it ends the rest,
-  // but for a key frame's: a codec's new picture quality, not a motion, so the frames
-  // before it are levelled with those after)
+  return smooth.size();
+}
+
+// Back from the cut: the climb, then up to kFitRestS of rest (a step in it ends the rest,
+// but for a key frame's: a codec's new picture quality, not a motion, so the frames before
+// it are levelled with those after, in `levelled`). Returns the first frame of the stretch.
+size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector<double>& smooth,
+                     size_t first, size_t cut, double threshold_px, double rest_noise_px,
+                     bool lossy, std::vector<double>& levelled) {
   const double tolerance = std::max(3 * rest_noise_px, 0.3 * threshold_px);
   const size_t half = FramesIn(samples, kSmoothHalfS);
-  std::vector<double> levelled = height, levelled_smooth = smooth;
+  std::vector<double> levelled_smooth = smooth;
   size_t flat_since = cut, start = cut;
   double anchor = smooth[cut];
   bool resting = false;
@@ -788,7 +774,8 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
       levelled_at = key;
       start = f;
       continue;
-    } else if (below) {
+    }
+    if (below) {
       anchor = levelled_smooth[f];
       flat_since = f;
     }
@@ -797,6 +784,37 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
     if (flat_s >= kRestingS) resting = true;
     if (flat_s >= kFitRestS) break;
   }
+  return start;
+}
+
+LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
+                          const std::vector<double>& height, size_t first, double threshold_px,
+                          double rest_noise_px, bool lossy) {
+  LiftoffSearch search;
+  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
+  for (size_t f = first; f < smooth.size(); ++f) {
+    if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
+  }
+  const size_t cut = FindCut(samples, smooth, first, threshold_px, lossy);
+  if (cut == smooth.size()) {
+    search.not_found = "the foot never lifts: its largest rise is " +
+                       FormatFixed(search.max_rise_px, 2) + " px above rest, below the " +
+                       FormatFixed(threshold_px, 2) + " px threshold held for " +
+                       FormatFixed(kSustainS, 1) + " s";
+    return search;
+  }
+  size_t cut_with_key = 0;
+  // a key frame soon after the cut shows the foot without lag: fit up to it
+  for (size_t f = cut + 1; f < smooth.size(); ++f) {
+    if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
+    if (lossy && samples[f].keyframe && std::isfinite(height[f])) {
+      cut_with_key = f;
+      break;
+    }
+  }
+  std::vector<double> levelled = height;
+  const size_t start = FindRestStart(samples, smooth, first, cut, threshold_px, rest_noise_px,
+                                     lossy, levelled);
   // the model over the stretch (raw heights: the fit is robust to single frames)
   // a lossy codec may hold slow motion back: a predicted frame until the picture is renewed,
   // an intra-only codec (MJPEG) by quantising an edge's sub-pixel position; a key frame
@@ -876,6 +894,27 @@ std::string PatchCount(size_t count) {
   return std::to_string(count) + (count == 1 ? " patch" : " patches");
 }
 
+// The liftoff instant's half-width, s, in quadrature: the spread of the acceptable knees'
+// crossings, a codec's lag (up to the bound allowed for, at least compression_error_px),
+// the registration's own error, the rest noise and, with an estimated scale, 3 % of the
+// threshold, each over the model's rise rate at the crossing.
+double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
+                           double crossing_s, double compression_error_px) {
+  const internal::RiseFit& fit = search.fit;
+  const double fit_spread =
+      std::max(crossing_s - fit.crossing_low_s, fit.crossing_high_s - crossing_s);
+  const double rate = std::max(fit.rate_at_crossing, 1e-9);
+  const double lag_px = search.lag_bound_px > 0
+                            ? std::max(compression_error_px, search.lag_bound_px)
+                            : compression_error_px;
+  const double scale_px =
+      track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px : 0.0;
+  const double px = std::sqrt(lag_px * lag_px + scale_px * scale_px +
+                              kRegistrationErrorPx * kRegistrationErrorPx +
+                              track.rest_noise_px * track.rest_noise_px);
+  return std::hypot(fit_spread, px / rate);
+}
+
 // Warnings where the evidence is weak; low_confidence when any is.
 void AddConfidenceWarnings(FootTrack& track, const PatchSelection& selection,
                            const internal::RiseFit& fit, double uncertainty_s) {
@@ -940,6 +979,34 @@ bool ShowsTapeColour(const std::vector<TrackedPatch>& patches, const std::vector
 
 }  // namespace
 
+// The ground's and the foot's patches in frame px (at rest) into `track`; the foot's box:
+// its patches' centres, a quarter patch beyond (a patch on the foot's edge is centred near
+// it).
+cv::Rect2d FootTracker::Impl::PlacePatches(const PatchSelection& selection,
+                                           FootTrack& track) const {
+  const auto frame_rect = [&](const PatchTemplate& templ) {
+    return cv::Rect(static_cast<int>(std::lround(work_px.x + templ.origin_px.x / scale)),
+                    static_cast<int>(std::lround(work_px.y + templ.origin_px.y / scale)),
+                    static_cast<int>(std::lround(kPatchPx / scale)),
+                    static_cast<int>(std::lround(kPatchPx / scale)));
+  };
+  for (size_t p : selection.ground) {
+    track.reference_patches_px.push_back(frame_rect(patches[p].templ));
+    track.reference_roi_px |= track.reference_patches_px.back();
+  }
+  cv::Rect2d foot_box;
+  const double quarter_px = 0.25 * kPatchPx / scale;
+  for (size_t p : selection.foot) {
+    const cv::Rect rect = frame_rect(patches[p].templ);
+    track.foot_patches_px.push_back(rect);
+    const cv::Point2d centre(rect.x + 0.5 * (rect.width - 1), rect.y + 0.5 * (rect.height - 1));
+    const cv::Rect2d around(centre.x - quarter_px, centre.y - quarter_px, 2 * quarter_px,
+                            2 * quarter_px);
+    foot_box = foot_box.area() > 0 ? (foot_box | around) : around;
+  }
+  return foot_box;
+}
+
 Result<FootTrack> FootTracker::Finish() const& { return FinishWith(impl_->samples); }
 
 Result<FootTrack> FootTracker::Finish() && { return FinishWith(std::move(impl_->samples)); }
@@ -977,32 +1044,11 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   FootTrack track;
   track.foot_roi_px = o.foot_roi_px;
   track.exposure_offset_ns = 0;  // a frame's time is the middle of its exposure
-  const auto frame_rect = [&](const PatchTemplate& templ) {
-    return cv::Rect(static_cast<int>(std::lround(s.work_px.x + templ.origin_px.x / s.scale)),
-                    static_cast<int>(std::lround(s.work_px.y + templ.origin_px.y / s.scale)),
-                    static_cast<int>(std::lround(kPatchPx / s.scale)),
-                    static_cast<int>(std::lround(kPatchPx / s.scale)));
-  };
-  for (size_t p : selection.ground) {
-    track.reference_patches_px.push_back(frame_rect(s.patches[p].templ));
-    track.reference_roi_px |= track.reference_patches_px.back();
-  }
-  // the foot's box: its patches' centres, a quarter patch beyond (a patch on the foot's
-  // edge is centred near it)
-  cv::Rect2d foot_box;
-  const double quarter_px = 0.25 * kPatchPx / s.scale;
-  for (size_t p : selection.foot) {
-    const cv::Rect rect = frame_rect(s.patches[p].templ);
-    track.foot_patches_px.push_back(rect);
-    const cv::Point2d centre(rect.x + 0.5 * (rect.width - 1), rect.y + 0.5 * (rect.height - 1));
-    const cv::Rect2d around(centre.x - quarter_px, centre.y - quarter_px, 2 * quarter_px,
-                            2 * quarter_px);
-    foot_box = foot_box.area() > 0 ? (foot_box | around) : around;
-  }
   if (selection.foot.empty()) {
     return NotFoundError("the foot never lifts: nothing in the foot region " +
                          RectText(o.foot_roi_px) + " rises against the ground around it");
   }
+  const cv::Rect2d foot_box = s.PlacePatches(selection, track);
   track.foot_center_x_px = foot_box.x + (foot_box.width - 1) / 2.0;
   track.foot_width_px = foot_box.width;
   track.foot_bottom_px = foot_box.y + foot_box.height - 0.5;
@@ -1055,21 +1101,8 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
                                           search.fit_last, fit.level + track.threshold_px);
     if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
   }
-  const double fit_spread =
-      std::max(crossing_s - fit.crossing_low_s, fit.crossing_high_s - crossing_s);
-  const double rate = std::max(fit.rate_at_crossing, 1e-9);
-  // a codec's lag at the crossing: up to the bound allowed for (at least the option's)
-  const double compression_s =
-      (search.lag_bound_px > 0 ? std::max(o.compression_error_px, search.lag_bound_px)
-                               : o.compression_error_px) /
-      rate;
-  const double scale_s =
-      track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px / rate : 0.0;
-  const double registration_s = kRegistrationErrorPx / rate;
-  const double noise_s = track.rest_noise_px / rate;  // a noisy curve crosses early or late
-  const double uncertainty_s =
-      std::sqrt(fit_spread * fit_spread + compression_s * compression_s + scale_s * scale_s +
-                registration_s * registration_s + noise_s * noise_s);
+  const double uncertainty_s = LiftoffUncertaintyS(track, search, crossing_s,
+                                                    o.compression_error_px);
   // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
   track.above_threshold =
       MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
