@@ -605,6 +605,13 @@ std::vector<Trial3dSpec> Ci3dSet() {
     spec.seed = seed;
     spec.scene.seed = seed;
     spec.quality = 23;
+    // The paper's test: 60 degrees over 40 s, so an error in time costs in rotation what
+    // it costs on hardware; the clip goes on 1.5 s past the 1 mm rule (the foot 15-25 mm
+    // up, before the simulated robot tips over).
+    const sim::ExperimentOptions paper;
+    spec.theta_rate_rad_s = paper.ramp_angle_rad / paper.ramp_duration_s;
+    spec.after_lift_s = 1.5;
+    spec.max_duration_s = 25.0;
     return spec;
   };
   {
@@ -689,8 +696,8 @@ std::vector<Trial3dSpec> Ci3dSet() {
   {
     Trial3dSpec& s = add("ci3d-10-reject-foot-never-lifts", 310);
     s.scene.view = CameraView::kOblique;
-    s.max_rotation_rad = 0.2;  // the ramp stops well before liftoff
-    s.max_duration_s = 5.0;
+    s.max_rotation_rad = 0.1;  // the ramp stops well before liftoff
+    s.max_duration_s = 8.0;
     s.foot = Foot::kB;
   }
   return set;

@@ -66,6 +66,8 @@ constexpr double kFitTopThresholdsLossless = 3.0;
 constexpr double kFitTopPxLossless = 1.5;
 // A key frame this soon after the fit's top extends the fit to it, s.
 constexpr double kKeyframeReachS = 1.5;
+// ... while the curve stays within this multiple of the fit's top.
+constexpr double kKeyframeReachTops = 3.0;
 // Weight of samples within a codec's possible lag below the model, and the least lag
 // allowed for when frames are predicted (internal::RiseFitOptions).
 constexpr double kLagWeight = 0.02;
@@ -804,9 +806,11 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
     return search;
   }
   size_t cut_with_key = 0;
-  // a key frame soon after the cut shows the foot without lag: fit up to it
+  // a key frame soon after the cut shows the foot without lag: fit up to it, unless the
+  // foot has gone far beyond the fit's top by then (a fast rise the model cannot follow)
   for (size_t f = cut + 1; f < smooth.size(); ++f) {
     if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
+    if (!(smooth[f] <= kKeyframeReachTops * smooth[cut])) break;
     if (lossy && samples[f].keyframe && std::isfinite(height[f])) {
       cut_with_key = f;
       break;
