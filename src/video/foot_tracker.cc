@@ -939,11 +939,11 @@ void AddConfidenceWarnings(FootTrack& track, const PatchSelection& selection,
                    " thresholds up");
   }
   for (const std::string& reason : weak) {
-    track.warnings.push_back("foot: low confidence: " + reason);
+    track.warnings.push_back("low confidence: " + reason);
   }
   track.low_confidence = !weak.empty();
   if (selection.ground.size() < kFewGroundPatches) {
-    track.warnings.push_back("foot: only " +
+    track.warnings.push_back("only " +
                              PatchCount(selection.ground.size()) +
                              " of static ground around the foot: camera shake is removed poorly");
   }
@@ -1066,7 +1066,7 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
     track.px_per_mm_estimated = !(o.px_per_mm > 0);
     track.threshold_px = o.threshold_mm * track.px_per_mm;
     if (track.px_per_mm_estimated) {
-      track.warnings.push_back("foot: scale estimated from the tracked foot's width (" +
+      track.warnings.push_back("scale estimated from the tracked foot's width (" +
                                FormatFixed(foot_box.width, 0) + " px taken as " +
                                FormatFixed(o.foot_width_mm, 0) +
                                " mm); give px_per_mm for a known scale");
@@ -1119,7 +1119,7 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   if (o.tape_colour) {
     track.located_by_tape = ShowsTapeColour(s.patches, selection.foot, *o.tape_colour);
     if (!track.located_by_tape) {
-      track.warnings.push_back("foot: the tracked foot does not show foot " +
+      track.warnings.push_back("the tracked foot does not show foot " +
                                std::string(FootName(*o.tape_colour)) +
                                "'s tape colour: check the verification image");
     }

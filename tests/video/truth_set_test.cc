@@ -82,6 +82,10 @@ ClipScore ScoreClip(const fs::path& folder) {
       static_cast<double>(events->led_on_uncertainty_ns + events->liftoff_uncertainty_ns) * 1e-6;
   score.truth_inside = std::abs(score.liftoff_error_ms) <= score.interval_uncertainty_ms;
   score.warnings = analysis->warnings.size();
+  for (const std::string& warning : analysis->warnings) {
+    // one module prefix: "foot: low confidence: ...", never "foot: foot: ..."
+    EXPECT_EQ(warning.find("foot: foot:"), std::string::npos) << warning;
+  }
   score.low_confidence = analysis->foot && analysis->foot->low_confidence;
   return score;
 }
