@@ -14,6 +14,7 @@
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "area_resize.h"
 #include "patch_registration.h"
 #include "rise_fit.h"
 #include "video_util.h"
@@ -52,6 +53,10 @@ constexpr int kLostFrames = 8;
 constexpr int kShakeSearchPx = 8;
 constexpr double kGroundLocalStepPx = 1.0;
 constexpr double kGroundResidualFactor = 1.25;
+// ... plus this, grey levels (a still, noiseless camera's residual is 0).
+constexpr double kGroundResidualFloor = 1.0;
+// A search's shift within this of the local registration's confirms it, px.
+constexpr double kGroundConfirmPx = 0.25;
 // Largest gain change accepted for a patch (a patch that needs more is not the same thing).
 constexpr double kMaxGain = 0.5;
 // A patch is the foot's when its final rise is at least this fraction of the foot's largest
@@ -210,13 +215,14 @@ struct FootTracker::Impl {
   double scale = 1;  // work px per frame px
   cv::Rect region_work_px;  // the foot region in work px
   cv::Mat work, accumulated;
+  internal::AreaResizer resizer;  // the work region to the work image (scale < 1)
   // the ground around the region as one weighted template, and without a border as the
   // template of the integer search; the last frame's shift of it (work px): a shaken camera
   // moves every patch at once, further than a small patch can follow alone
   PatchTemplate ground_fine;
   cv::Mat ground_search, ground_mask, search_scores, grey;
   cv::Point2d global_shift_px;
-  double ground_residual = 0;  // the ground's usual residual, grey levels
+  double ground_residual = -1;  // the ground's usual residual, grey levels (-1: not yet)
   int accumulated_frames = 0;
   bool initialised = false;
   std::vector<TrackedPatch> patches;
@@ -245,6 +251,7 @@ void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
             cv::Rect(0, 0, size.width, size.height);
   // never enlarged (enlarging a small region was measured worse)
   scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
+  if (scale < 1) resizer = internal::AreaResizer(work_px.size(), scale);
   const auto to_work = [&](int v, int origin) {
     return static_cast<int>(std::lround((v - origin) * scale));
   };
@@ -254,13 +261,12 @@ void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
 }
 
 void FootTracker::Impl::MakeWorkImage(const cv::Mat& bgr) {
-  cv::Mat crop = bgr(work_px), scaled;
+  const cv::Mat crop = bgr(work_px);
   if (scale < 1) {
-    cv::resize(crop, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+    resizer.Apply(crop, work);
   } else {
-    scaled = crop;
+    crop.convertTo(work, CV_32FC3);
   }
-  scaled.convertTo(work, CV_32FC3);
 }
 
 // Candidates on a grid, strongest vertical texture first, none overlapping another by more
@@ -353,7 +359,9 @@ cv::Point2d FootTracker::Impl::GroundShift() {
   const PatchMatch local = internal::RegisterPatch(
       ground_fine, grey, ground_fine.origin_px + global_shift_px, 10, 0.005);
   const cv::Point2d local_shift = local.origin_px - ground_fine.origin_px;
-  const bool usual = ground_residual > 0 && local.residual_rms <= kGroundResidualFactor * ground_residual;
+  const bool usual = ground_residual >= 0 && local.residual_rms <= kGroundResidualFactor *
+                                                                     ground_residual +
+                                                                 kGroundResidualFloor;
   if (local.ok && usual && cv::norm(local_shift - global_shift_px) < kGroundLocalStepPx) {
     ground_residual = 0.9 * ground_residual + 0.1 * local.residual_rms;
     return local_shift;
@@ -368,8 +376,12 @@ cv::Point2d FootTracker::Impl::GroundShift() {
   const cv::Point2d shift = fine.origin_px - ground_fine.origin_px;
   const bool near = std::abs(shift.x - guess.x) <= 1 && std::abs(shift.y - guess.y) <= 1;
   if (!(fine.ok && near)) return guess;
-  ground_residual = ground_residual > 0 ? 0.9 * ground_residual + 0.1 * fine.residual_rms
-                                        : fine.residual_rms;
+  // the search confirmed the local registration: its residual is the usual one now (the
+  // scene around the foot changes slowly: light, the robot's own parts)
+  const bool confirmed = local.ok && cv::norm(shift - local_shift) < kGroundConfirmPx;
+  ground_residual = ground_residual >= 0 && !confirmed
+                        ? 0.9 * ground_residual + 0.1 * fine.residual_rms
+                        : fine.residual_rms;
   return shift;
 }
 
