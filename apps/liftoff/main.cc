@@ -310,7 +310,7 @@ int main(int argc, char** argv) {
       "synth",
       "Render synthetic trials (video, controller log, ground truth) from a spec or a set");
   synth_app->add_option("spec", synth.spec_path, "Trial spec JSON (see --print-spec)");
-  synth_app->add_option("--set", synth.set_name, "Write a whole named set: ci, paper or ci3d (the 3D camera)");
+  synth_app->add_option("--set", synth.set_name, "Write a whole named set: ci, paper, ci3d or hard3d (the 3D camera)");
   synth_app->add_option("--output,-o", synth.output_dir, "Folder for the files");
   synth_app->add_flag("--print-spec", synth.print_spec, "Print the default spec as JSON");
   synth_app->add_flag("--quiet,-q", synth.quiet, "No progress lines on stderr");

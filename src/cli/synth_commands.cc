@@ -90,7 +90,7 @@ int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::o
   const auto progress = [&](int index, int count, const std::string& id) {
     if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
   };
-  auto summary = synth::WriteCi3dSet(command.output_dir, calibration, progress);
+  auto summary = synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress);
   if (!summary.ok()) return ReportError(summary.status(), err);
   for (const synth::WrittenTrial3d& written : summary->trials) {
     const auto seconds = [](const std::optional<double>& value, int places) {
@@ -138,7 +138,9 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
-  if (command.set_name == "ci3d") return RunSet3d(command, *calibration, out, err);
+  if (command.set_name == "ci3d" || command.set_name == "hard3d") {
+    return RunSet3d(command, *calibration, out, err);
+  }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
                                   : RunSet(command, *calibration, out, err);
 }

@@ -92,6 +92,8 @@ constexpr size_t kTopPixelsShare = 256;
 constexpr double kPixelNoiseSigmas = 5.0;
 constexpr double kPixelStepFrac = 0.1;
 constexpr double kRoiOppositeFrac = 0.5;
+// ... counting only pixels that step by more than this fraction of the largest step.
+constexpr double kRoiStrongFrac = 0.3;
 // With an ROI, each row's flicker gain leaves out pixels brighter than this many times
 // the frame's gain (a light that switched on, not the lamp's flicker, up to +-50 %).
 constexpr double kRowRatioMax = 1.6;
@@ -720,16 +722,19 @@ struct LedDetector::Impl {
     const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
     const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
     const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
-    double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
+    // an edge that moved steps its two sides by as much either way; a codec that renews the
+    // LED's block moves many pixels a little either way: only strong steps count here
+    const double strong = kRoiStrongFrac * largest;
+    double stepped = 0.0, stepped_strong = 0.0, opposite_strong = 0.0, unclipped = 0.0;
     for (size_t i = 0; i < pixels; ++i) {
       if (pixel_steps[i] > clear) {
         stepped += pixel_steps[i];
         if (lit_peaks[i] < kClipLevels) unclipped += pixel_steps[i];
-      } else if (pixel_steps[i] < -clear) {
-        opposite -= pixel_steps[i];
       }
+      if (pixel_steps[i] > strong) stepped_strong += pixel_steps[i];
+      if (pixel_steps[i] < -strong) opposite_strong -= pixel_steps[i];
     }
-    if (stepped <= 0.0 || opposite > kRoiOppositeFrac * stepped) return false;
+    if (stepped <= 0.0 || opposite_strong > kRoiOppositeFrac * stepped_strong) return false;
     event.clipped = unclipped < kUnclippedShare * stepped;
     // the dating dating_series and the LED's contrast over the chosen pixels
     std::fill(dating_series.begin(), dating_series.end(), 0.0);

@@ -366,6 +366,35 @@ TEST(Trial3d, ValidateNamesTheField) {
   EXPECT_NE(spec.Validate().message().find("fovy_deg"), std::string::npos);
   EXPECT_TRUE(Trial3dSpec().Validate().ok());
   for (const Trial3dSpec& clip : Ci3dSet()) EXPECT_TRUE(clip.Validate().ok()) << clip.id;
+  for (const Trial3dSpec& clip : Hard3dSet()) EXPECT_TRUE(clip.Validate().ok()) << clip.id;
+  spec = Trial3dSpec();
+  spec.drop_frames_at_led = 6;
+  EXPECT_NE(spec.Validate().message().find("drop_frames_at_led"), std::string::npos);
+  EXPECT_FALSE(Set3dNamed("ci4d").ok());
+}
+
+// drop_frames_at_led: the frames whose exposure ends after the switch-on are missing, as
+// many as asked, so the first frame that shows the LED lit is wholly lit and comes two
+// frame intervals late; the truth's frame list and the video agree.
+TEST(Trial3d, FramesDroppedAtTheLedAreMissingFromVideoAndTruth) {
+  REQUIRE_EGL();
+  testing::ScratchDir scratch;
+  Trial3dSpec spec = ShortSpec();
+  spec.drop_frames_at_led = 2;
+  auto written = WriteTrial3d(spec, Calibration2018(), scratch.path());
+  ASSERT_TRUE(written.ok()) << written.status().ToString();
+  const nlohmann::json truth = ReadJson(written->truth_path);
+  const int first = truth["led_first_lit_frame"].get<int>();
+  const double before = truth["pts"][static_cast<size_t>(first - 1)].get<double>();
+  const double after = truth["pts"][static_cast<size_t>(first)].get<double>();
+  // the LED at 1.03 s: the frames at 1.033 s (partly lit) and 1.067 s are dropped
+  EXPECT_NEAR(before, 1.0, 1e-3);
+  EXPECT_NEAR(after, 1.1, 1e-3);
+  EXPECT_EQ(truth["led_frac"][static_cast<size_t>(first)].get<double>(), 1.0);
+  cv::VideoCapture capture(written->video_path.string());
+  int frames = 0;
+  for (cv::Mat frame; capture.read(frame);) ++frames;
+  EXPECT_EQ(frames, truth["n_frames"].get<int>());
 }
 
 }  // namespace

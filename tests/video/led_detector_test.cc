@@ -188,6 +188,10 @@ struct TinyLedStream {
   std::optional<double> on_s;      // switch-on, video clock
   std::vector<int> dropped;        // frames left out of the stream (a variable frame rate)
   int frames = 90;
+  double noise_sigma = 4.0;  // sensor noise, levels
+  // From the first lit frame on, the 16 x 16 block around the LED renewed by a codec: each
+  // pixel of the wall there moves by this many levels up or down (a fixed random pattern).
+  double renew_block_levels = 0.0;
   cv::Point led_px{212, 96};
   cv::Rect Roi() const { return cv::Rect(led_px.x - 30, led_px.y - 34, 64, 64); }
   double PeriodNs() const { return 1e9 / fps; }
@@ -231,8 +235,19 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
       picture.row(y) *= gain;
     }
     picture += lit * light;
+    if (lit > 0 && stream.renew_block_levels > 0) {
+      const cv::Rect block(stream.led_px.x / 16 * 16, stream.led_px.y / 16 * 16, 16, 16);
+      cv::RNG signs(99);
+      for (int y = block.y; y < block.y + 16; ++y) {
+        for (int x = block.x; x < block.x + 16; ++x) {
+          const float change = static_cast<float>(
+              (signs.uniform(0, 2) == 0 ? -1 : 1) * stream.renew_block_levels);
+          picture.at<cv::Vec3f>(y, x) += cv::Vec3f(change, change, change);
+        }
+      }
+    }
     cv::Mat grain(size, CV_32FC3);
-    noise.fill(grain, cv::RNG::NORMAL, cv::Scalar::all(0), cv::Scalar::all(4));
+    noise.fill(grain, cv::RNG::NORMAL, cv::Scalar::all(0), cv::Scalar::all(stream.noise_sigma));
     picture += grain;
     Frame frame;
     frame.index = static_cast<int64_t>(frames.size());
@@ -256,6 +271,22 @@ TEST(LedDetector, FindsATinySaturatingLedInABigFlickeringNoisyRegion) {
   EXPECT_LE(std::abs(error_ns), 0.5 * stream.PeriodNs()) << result->Brief();
   EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
   EXPECT_GE(result->contrast_levels, 100.0);
+}
+
+// A codec that renews the LED's block when the LED lights moves every pixel of that block
+// a little, half of them down; on a frozen (noiseless) picture those are clear steps. Only
+// strong opposite steps make an edge, so the switch-on is still found.
+TEST(LedDetector, FindsTheSwitchOnWhenACodecRenewsTheLedsBlockAroundIt) {
+  TinyLedStream stream;
+  stream.noise_sigma = 0.0;
+  stream.renew_block_levels = 12.0;
+  stream.on_s = 1.5;
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  EXPECT_LE(std::abs(static_cast<double>(result->pulses[0].on_ns) - *stream.on_s * 1e9),
+            0.5 * stream.PeriodNs())
+      << result->Brief();
 }
 
 TEST(LedDetector, ADroppedFrameAtTheSwitchOnWidensTheIntervalToTheRealTimestamps) {

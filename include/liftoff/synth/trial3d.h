@@ -77,6 +77,9 @@ struct Trial3dSpec {
   /// (0 .. 0.4/fps). As CameraSpec.
   double drop_probability = 0.0;
   double timestamp_jitter_s = 0.0;
+  /// This many frames dropped from the first whose exposure ends after the LED switch-on
+  /// (0 .. 5): the camera misses the switch-on itself.
+  int drop_frames_at_led = 0;
   VideoCodec codec = VideoCodec::kH264;
   /// CRF (h264) or q:v (mjpeg), as CameraSpec.
   int quality = 20;
@@ -171,17 +174,27 @@ struct WrittenTrial3d {
 Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& calibration,
                                     const std::filesystem::path& output_dir);
 
-/// The 3D CI set: short clips (LED at 2 s, liftoff ~2.5-3.5 s later, 1 s after it) with
-/// side, oblique and front views, 480p and 720p, H.264, MJPEG and a VFR-with-drops case,
-/// sphere, block and rubber-tip feet, shadows, a glossy floor, a small LED, low light
-/// with noise; and two reject clips (LED never on; foot never lifts). docs/synth.md.
+/// The 3D CI set: clips at the paper's ramp rate (LED at about 2 s, liftoff 16-17.5 s
+/// later, the clip 1.5 s longer) with side, oblique and front views, 480p and 720p, H.264,
+/// MJPEG and a VFR-with-drops case, sphere, block and rubber-tip feet, shadows, a glossy
+/// floor, a small LED, low light with noise; and two reject clips (LED never on; foot
+/// never lifts). docs/synth.md.
 std::vector<Trial3dSpec> Ci3dSet();
 
-/// Writes every trial of Ci3dSet into `output_dir` on this thread (one EGL context; Mesa
+/// A harder 3D set for development, not rendered in CI (about 5 min): strong flicker with a
+/// short exposure, low light with shake, frames dropped at the LED, a small and a large
+/// robot in frame, a tiny LED, a glossy floor in low light, MJPEG with shake. docs/synth.md.
+std::vector<Trial3dSpec> Hard3dSet();
+
+/// The 3D set of that name ("ci3d" or "hard3d"); kInvalidArgument for another.
+Result<std::vector<Trial3dSpec>> Set3dNamed(const std::string& name);
+
+/// Writes every trial of the named 3D set into `output_dir` on this thread (one EGL context; Mesa
 /// renders on all cores), then `manifest.json` (the ok clips) and `set.json` (the index:
 /// id, folder, expect, frames, render time).
 /// `progress` (may be empty) is called before each trial with (index, count, id).
 struct Set3dSummary {
+  std::string name;  ///< the set's: "ci3d", "hard3d"
   std::vector<WrittenTrial3d> trials;
   int64_t frames = 0;
   double wall_seconds = 0.0, render_seconds = 0.0, encode_seconds = 0.0;
@@ -189,8 +202,8 @@ struct Set3dSummary {
   /// "ci3d: 10 clips, 1234 frames in 61.2 s (render 35.1 ms/frame, encode 4.2 ms/frame)".
   std::string Brief() const;
 };
-Result<Set3dSummary> WriteCi3dSet(
-    const std::filesystem::path& output_dir, const Calibration& calibration,
+Result<Set3dSummary> WriteSet3d(
+    const std::string& name, const std::filesystem::path& output_dir, const Calibration& calibration,
     const std::function<void(int index, int count, const std::string& id)>& progress = {});
 
 }  // namespace liftoff::synth
