@@ -1250,12 +1250,12 @@ struct LedDetector::Impl {
     }
     if (already_on) {
       result.warnings.push_back(
-          "LED already on at the start: it went off before its first switch-on, which may have "
+          "already on at the start: it went off before its first switch-on, which may have "
           "been missed");
     }
     if (result.contrast_levels < options.dim_warning_levels) {
       result.warnings.push_back(
-          "LED dim: on-off contrast " + FormatFixed(result.contrast_levels, 0) +
+          "dim: on-off contrast " + FormatFixed(result.contrast_levels, 0) +
           " grey levels (expected >= " + FormatFixed(options.dim_warning_levels, 0) + ")");
     }
     return result;

@@ -349,7 +349,7 @@ TEST(LedDetector, WarnsWhenTheLedIsDim) {
     EXPECT_NEAR(result->contrast_levels, 14.0, 1.0);
     EXPECT_NEAR(static_cast<double>(result->pulses.at(0).on_ns), 0.5e9, 0.5 * stream.PeriodNs());
     ASSERT_EQ(result->warnings.size(), 1u);
-    EXPECT_THAT(result->warnings[0], HasSubstr("LED dim: on-off contrast 14 grey levels"));
+    EXPECT_THAT(result->warnings[0], HasSubstr("dim: on-off contrast 14 grey levels"));
   }
 }
 
