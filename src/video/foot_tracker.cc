@@ -1027,6 +1027,87 @@ Result<FootTrack> FootTracker::Finish() const& { return FinishWith(impl_->sample
 
 Result<FootTrack> FootTracker::Finish() && { return FinishWith(std::move(impl_->samples)); }
 
+namespace {
+
+// The rest window's frames among those measured from `first`: inside [from, to) when it is
+// set, else the first `rest_frames`.
+std::vector<size_t> RestFrames(const std::vector<HeightSample>& samples, size_t first,
+                               int64_t from_ns, int64_t to_ns, int rest_frames) {
+  std::vector<size_t> rest;
+  for (size_t f = first; f < samples.size(); ++f) {
+    const int64_t t = samples[f].t_ns;
+    const bool inside = to_ns > from_ns ? (t >= from_ns && t < to_ns)
+                                        : f < first + static_cast<size_t>(rest_frames);
+    if (inside) rest.push_back(f);
+  }
+  return rest;
+}
+
+// The scale and the threshold: given, or the scale from the tracked foot's width.
+void SetScale(const FootTracker::Options& o, double foot_width_px, FootTrack& track) {
+  if (o.threshold_px > 0) {
+    track.threshold_px = o.threshold_px;
+    track.px_per_mm = o.px_per_mm;
+    return;
+  }
+  track.px_per_mm = o.px_per_mm > 0 ? o.px_per_mm : foot_width_px / o.foot_width_mm;
+  track.px_per_mm_estimated = !(o.px_per_mm > 0);
+  track.threshold_px = o.threshold_mm * track.px_per_mm;
+  if (track.px_per_mm_estimated) {
+    track.warnings.push_back("scale estimated from the tracked foot's width (" +
+                             FormatFixed(foot_width_px, 0) + " px taken as " +
+                             FormatFixed(o.foot_width_mm, 0) +
+                             " mm); give px_per_mm for a known scale");
+  }
+}
+
+// Each sample's rise (held over frames not measured), shake and quality; the rest's noise.
+void FillSamples(const PatchSelection& selection, const std::vector<size_t>& rest,
+                 double min_quality, std::vector<HeightSample>& samples, FootTrack& track) {
+  double held = 0;
+  for (size_t f = 0; f < samples.size(); ++f) {
+    HeightSample& sample = samples[f];
+    const double h = selection.height_px[f];
+    if (std::isfinite(h)) held = h;
+    sample.rise_px = held;
+    sample.shake_y_px = -selection.shake_px[f];
+    sample.quality = std::isfinite(h) ? selection.quality[f] : 0.0;
+    if (!std::isfinite(h) || sample.quality < min_quality) ++track.poor_frames;
+  }
+  std::vector<double> rest_heights;
+  for (size_t f : rest) rest_heights.push_back(selection.height_px[f]);
+  track.rest_rise_px = 0;
+  track.rest_noise_px = RobustSpread(rest_heights);
+}
+
+// The liftoff instant and its onset from the search. With a codec's lag the fit only
+// bounds the instant: its middle; without, the curve itself is exact to noise, and a line
+// through the frames around its crossing beats the model's two terms (when it lies inside
+// the model's interval).
+void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& selection,
+                const LiftoffSearch& search, double compression_error_px, FootTrack& track) {
+  const internal::RiseFit& fit = search.fit;
+  double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
+  if (search.lag_bound_px == 0 && track.rest_noise_px < kLocalCrossingNoisePx) {
+    const double local_s = LocalCrossingS(samples, selection.height_px, search.fit_first,
+                                          search.fit_last, fit.level + track.threshold_px);
+    if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
+  }
+  const double uncertainty_s =
+      LiftoffUncertaintyS(track, search, crossing_s, compression_error_px);
+  // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
+  track.above_threshold =
+      MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
+  track.onset = MakeEvent(samples, fit.knee_s,
+                          std::max(fit.knee_s - fit.knee_low_s, fit.knee_high_s - fit.knee_s));
+  track.fit_first_frame = samples[search.fit_first].frame_index;
+  track.fit_last_frame = samples[search.fit_last].frame_index;
+  track.fit_noise_px = fit.noise;
+  AddConfidenceWarnings(track, selection, fit, uncertainty_s);
+}
+
+}  // namespace
+
 Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) const {
   const Impl& s = *impl_;
   const Options& o = s.options;
@@ -1038,16 +1119,8 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   }
   const size_t frames = samples.size();
   const RiseTable table(s.rises, s.patches.size(), s.measured_from);
-
-  // the rest window's frames
-  std::vector<size_t> rest;
-  for (size_t f = s.measured_from; f < frames; ++f) {
-    const int64_t t = samples[f].t_ns;
-    const bool inside = s.rest_to_ns > s.rest_from_ns
-                            ? (t >= s.rest_from_ns && t < s.rest_to_ns)
-                            : f < s.measured_from + static_cast<size_t>(o.rest_frames);
-    if (inside) rest.push_back(f);
-  }
+  const std::vector<size_t> rest =
+      RestFrames(samples, s.measured_from, s.rest_from_ns, s.rest_to_ns, o.rest_frames);
   if (rest.empty()) {
     return InvalidArgumentError("the rest window " + FormatSeconds(s.rest_from_ns, 4) + " .. " +
                                 FormatSeconds(s.rest_to_ns, 4) +
@@ -1068,66 +1141,15 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   track.foot_center_x_px = foot_box.x + (foot_box.width - 1) / 2.0;
   track.foot_width_px = foot_box.width;
   track.foot_bottom_px = foot_box.y + foot_box.height - 0.5;
+  SetScale(o, foot_box.width, track);
+  FillSamples(selection, rest, o.min_quality, samples, track);
 
-  // the scale and the threshold
-  if (o.threshold_px > 0) {
-    track.threshold_px = o.threshold_px;
-    track.px_per_mm = o.px_per_mm;
-  } else {
-    track.px_per_mm = o.px_per_mm > 0 ? o.px_per_mm : foot_box.width / o.foot_width_mm;
-    track.px_per_mm_estimated = !(o.px_per_mm > 0);
-    track.threshold_px = o.threshold_mm * track.px_per_mm;
-    if (track.px_per_mm_estimated) {
-      track.warnings.push_back("scale estimated from the tracked foot's width (" +
-                               FormatFixed(foot_box.width, 0) + " px taken as " +
-                               FormatFixed(o.foot_width_mm, 0) +
-                               " mm); give px_per_mm for a known scale");
-    }
-  }
-
-  // the samples and the rest
-  std::vector<double> rest_heights;
-  double held = 0;
-  for (size_t f = 0; f < frames; ++f) {
-    HeightSample& sample = samples[f];
-    const double h = selection.height_px[f];
-    if (std::isfinite(h)) held = h;
-    sample.rise_px = held;
-    sample.shake_y_px = -selection.shake_px[f];
-    sample.quality = std::isfinite(h) ? selection.quality[f] : 0.0;
-    if (!std::isfinite(h) || sample.quality < o.min_quality) ++track.poor_frames;
-  }
-  for (size_t f : rest) rest_heights.push_back(selection.height_px[f]);
-  track.rest_rise_px = 0;
-  track.rest_noise_px = RobustSpread(rest_heights);
-
-  // the liftoff
   const LiftoffSearch search = FindLiftoff(samples, selection.height_px, rest.front(),
                                            track.threshold_px, track.rest_noise_px,
                                            o.compression_error_px > 0);
   track.max_rise_px = search.max_rise_px;
   if (!search.not_found.empty()) return NotFoundError(search.not_found);
-  const internal::RiseFit& fit = search.fit;
-  // with a codec's lag the fit only bounds the instant: its middle; without, the curve itself
-  // is exact to noise, and a line through the frames around its crossing beats the model's
-  // two terms (when it lies inside the model's interval)
-  double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
-  if (search.lag_bound_px == 0 && track.rest_noise_px < kLocalCrossingNoisePx) {
-    const double local_s = LocalCrossingS(samples, selection.height_px, search.fit_first,
-                                          search.fit_last, fit.level + track.threshold_px);
-    if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
-  }
-  const double uncertainty_s = LiftoffUncertaintyS(track, search, crossing_s,
-                                                    o.compression_error_px);
-  // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
-  track.above_threshold =
-      MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
-  track.onset = MakeEvent(samples, fit.knee_s,
-                          std::max(fit.knee_s - fit.knee_low_s, fit.knee_high_s - fit.knee_s));
-  track.fit_first_frame = samples[search.fit_first].frame_index;
-  track.fit_last_frame = samples[search.fit_last].frame_index;
-  track.fit_noise_px = fit.noise;
-  AddConfidenceWarnings(track, selection, fit, uncertainty_s);
+  SetLiftoff(samples, selection, search, o.compression_error_px, track);
   if (o.tape_colour) {
     track.located_by_tape = ShowsTapeColour(s.patches, selection.foot, *o.tape_colour);
     if (!track.located_by_tape) {
