@@ -92,8 +92,11 @@ constexpr size_t kTopPixelsShare = 256;
 constexpr double kPixelNoiseSigmas = 5.0;
 constexpr double kPixelStepFrac = 0.1;
 constexpr double kRoiOppositeFrac = 0.5;
-// ... counting only pixels that step by more than this fraction of the largest step.
+// But a small light (its strong steps, kRoiStrongFrac of the largest or more, within a
+// kSmallLightPx square) is one when the strong steps the other way stay under that share:
+// a codec renewing a tiny LED's block moves many pixels a little either way.
 constexpr double kRoiStrongFrac = 0.3;
+constexpr size_t kSmallLightPx = 6;
 // With an ROI, each row's flicker gain leaves out pixels brighter than this many times
 // the frame's gain (a light that switched on, not the lamp's flicker, up to +-50 %).
 constexpr double kRowRatioMax = 1.6;
@@ -688,6 +691,30 @@ struct LedDetector::Impl {
   // that clip when lit unless they carry most of the step (then the event is marked
   // clipped). False when the step does not look like a light: pixels stepping the other
   // way by a good part of it (an edge moved by camera shake or a passing part).
+  // Whether the pixels that stepped strongly (kRoiStrongFrac of the largest step or more)
+  // are a small light, within a kSmallLightPx square, that the strong steps the other way
+  // do not match: a codec that renews a tiny LED's block moves many pixels a little either
+  // way (too many for the sum of every clear step), where an edge that moved steps its two
+  // sides strongly along its length. Reads pixel_steps.
+  bool SmallLightInRenewedBlock(double largest, size_t width) const {
+    const double strong = kRoiStrongFrac * largest;
+    double stepped_strong = 0.0, opposite_strong = 0.0;
+    size_t x0 = width, x1 = 0, y0 = pixel_steps.size(), y1 = 0;
+    for (size_t i = 0; i < pixel_steps.size(); ++i) {
+      if (pixel_steps[i] > strong) {
+        stepped_strong += pixel_steps[i];
+        x0 = std::min(x0, i % width);
+        x1 = std::max(x1, i % width);
+        y0 = std::min(y0, i / width);
+        y1 = std::max(y1, i / width);
+      } else if (pixel_steps[i] < -strong) {
+        opposite_strong -= pixel_steps[i];
+      }
+    }
+    const bool small = x1 >= x0 && x1 - x0 < kSmallLightPx && y1 - y0 < kSmallLightPx;
+    return small && opposite_strong <= kRoiOppositeFrac * stepped_strong;
+  }
+
   bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
     const size_t pixels = pixel_reference.size();
     const auto frames_in_ring = static_cast<size_t>(ring);
@@ -722,19 +749,19 @@ struct LedDetector::Impl {
     const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
     const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
     const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
-    // an edge that moved steps its two sides by as much either way; a codec that renews the
-    // LED's block moves many pixels a little either way: only strong steps count here
-    const double strong = kRoiStrongFrac * largest;
-    double stepped = 0.0, stepped_strong = 0.0, opposite_strong = 0.0, unclipped = 0.0;
+    double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
     for (size_t i = 0; i < pixels; ++i) {
       if (pixel_steps[i] > clear) {
         stepped += pixel_steps[i];
         if (lit_peaks[i] < kClipLevels) unclipped += pixel_steps[i];
+      } else if (pixel_steps[i] < -clear) {
+        opposite -= pixel_steps[i];
       }
-      if (pixel_steps[i] > strong) stepped_strong += pixel_steps[i];
-      if (pixel_steps[i] < -strong) opposite_strong -= pixel_steps[i];
     }
-    if (stepped <= 0.0 || opposite_strong > kRoiOppositeFrac * stepped_strong) return false;
+    if (stepped <= 0.0) return false;
+    if (opposite > kRoiOppositeFrac * stepped && !SmallLightInRenewedBlock(largest, width)) {
+      return false;
+    }
     event.clipped = unclipped < kUnclippedShare * stepped;
     // the dating dating_series and the LED's contrast over the chosen pixels
     std::fill(dating_series.begin(), dating_series.end(), 0.0);
