@@ -293,9 +293,27 @@ TEST(Model, NegativeStiffnessIsNamedWithItsPointer) {
   const Status status = LoadError(document);
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
   EXPECT_NE(status.message().find("tiny.json: /cable_groups/0/stiffness_n_per_m: expected a "
-                                  "number > 0, got -5"),
+                                  "number in [0.001, 1e+08], got -5"),
             std::string::npos)
       << status.message();
+}
+
+// positive is not enough: a stiffness of 1e-320 or 1e300 passes "> 0" and breaks the engine
+TEST(Model, FieldsOutsidePhysicalRangesAreNamedWithTheirPointer) {
+  for (const auto& [pointer, value] :
+       {std::pair{"/cable_groups/0/stiffness_n_per_m", 1e-320},
+        std::pair{"/cable_groups/0/stiffness_n_per_m", 1e300},
+        std::pair{"/cable_groups/0/damping_n_s_per_m", 1e300},
+        std::pair{"/cable_groups/0/pretension_n", 1e300}}) {
+    SCOPED_TRACE(pointer);
+    nlohmann::json document = TinyModel();
+    document[nlohmann::json::json_pointer(pointer)] = value;
+    const Status status = LoadError(document);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(status.message().find(std::string("tiny.json: ") + pointer + ": expected a number in"),
+              std::string::npos)
+        << status.message();
+  }
 }
 
 TEST(Model, NotANumberIsNamedWithItsPointer) {
