@@ -102,6 +102,8 @@ struct HostileCase {
   int exit_code;
   /// Every one must be in standard error.
   std::vector<std::string> culprits;
+  /// None may be in standard output or error (work that must not have happened).
+  std::vector<std::string> absent = {};
 };
 
 std::string Expand(std::string arguments, const ScratchDir& scratch) {
@@ -261,7 +263,8 @@ const std::vector<HostileCase>& Cases() {
       {"table with a negative --max-bad-lines", OneTrial,
        "table @/manifest.json --max-bad-lines -1", 3, {"--max-bad-lines"}},
       {"sim sweep --hardware of a missing manifest", nullptr,
-       "sim sweep --hardware @/missing.json --progress off", 4, {"--hardware", "missing.json"}},
+       "sim sweep --hardware @/missing.json --progress off", 4, {"--hardware", "missing.json"},
+       {"s wall"}},  // failed before the sweep, not after it
       {"a trial id with a line break",
        [](const ScratchDir& s) {
          WriteFile(s / "A1.csv", LiftoffLog());
@@ -285,6 +288,7 @@ TEST_P(HostileInput, FailsNamingTheCulpritAndChangesNoFile) {
                                                       scratch);
   EXPECT_EQ(run.code, c.exit_code) << run.err;
   for (const std::string& culprit : c.culprits) EXPECT_THAT(run.err, HasSubstr(culprit));
+  for (const std::string& text : c.absent) EXPECT_THAT(run.out + run.err, Not(HasSubstr(text)));
   EXPECT_THAT(run.err, Not(HasSubstr("internal error")));
   EXPECT_THAT(run.out, Not(HasSubstr("nan")));  // errors may quote a bad "nan"; results never
   // inputs and earlier outputs unchanged, nothing new (no temporary file left behind)
@@ -328,6 +332,16 @@ TEST(HostileSim, ADivergedRunIsItsOwnOutcomeWithItsOwnExitCode) {
   EXPECT_THAT(run.err, HasSubstr("diverged at t = "));
   EXPECT_THAT(run.out, Not(HasSubstr("did not lift")));
   EXPECT_THAT(run.out + run.err + ReadFile(scratch / "c.csv"), Not(HasSubstr("nan")));
+  // every flag in range: a coarse step with stiff cables
+  const CommandRun stiff = liftoff::testing::RunCommand(
+      LIFTOFF_BINARY,
+      "sim run --foot A --dt 0.01 --stiffness 20000,20000,20000 --json --progress off", scratch);
+  EXPECT_EQ(stiff.code, kExitDiverged) << stiff.err;
+  const nlohmann::json outcome = nlohmann::json::parse(stiff.out);
+  EXPECT_EQ(outcome["status"], "diverged");
+  EXPECT_EQ(outcome["stood"], false);
+  EXPECT_TRUE(outcome["liftoff_rad"].is_null());
+  EXPECT_GT(outcome["diverged_at_s"].get<double>(), 0.0);
 }
 
 TEST(HostileSim, ADivergedRunIsMarkedInTheSweepAndLeftOutOfTheRange) {
