@@ -330,6 +330,7 @@ TEST(HostileSim, ADivergedRunIsItsOwnOutcomeWithItsOwnExitCode) {
   EXPECT_EQ(run.code, kExitDiverged) << run.err;
   EXPECT_THAT(run.out, HasSubstr("diverged at t = "));
   EXPECT_THAT(run.err, HasSubstr("diverged at t = "));
+  EXPECT_THAT(run.err, HasSubstr("m/s (at most 1000 m/s is physical)"));
   EXPECT_THAT(run.out, Not(HasSubstr("did not lift")));
   EXPECT_THAT(run.out + run.err + ReadFile(scratch / "c.csv"), Not(HasSubstr("nan")));
   // every flag in range: a coarse step with stiff cables

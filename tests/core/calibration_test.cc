@@ -340,17 +340,22 @@ TEST(CalibrationFile, RatiosAndStiffnessesOutsidePhysicalRangesAreRejected) {
   struct Case {
     std::string pointer;
     double value;
+    std::string range;  // as docs/calibration.md gives it
   };
-  for (const Case& c : {Case{"/motor/gearbox_ratio", 1e-320}, Case{"/motor/gearbox_ratio", 1e300},
-                        Case{"/rotating_vertebra/spur_gear_ratio", 1e-320},
-                        Case{"/motor/encoder_counts_per_motor_rev", 0.5},
-                        Case{"/materials/0/stiffness_n_per_m", 1e300}}) {
+  for (const Case& c :
+       {Case{"/motor/gearbox_ratio", 1e-320, "[0.01, 100000]"},
+        Case{"/motor/gearbox_ratio", 1e300, "[0.01, 100000]"},
+        Case{"/rotating_vertebra/spur_gear_ratio", 1e-320, "[0.01, 100000]"},
+        Case{"/motor/encoder_counts_per_motor_rev", 0.5, "[1, 1e+07]"},
+        Case{"/materials/0/stiffness_n_per_m", 1e300, "[0.001, 1e+07]"},
+        Case{"/tension_points/0/spring_n_per_m", 1e-320, "[0.001, 1e+07]"}}) {
     SCOPED_TRACE(c.pointer);
     json document = ShippedJson();
     document[json::json_pointer(c.pointer)] = c.value;
     const Status status = FromJsonStatus(document);
     EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-    EXPECT_THAT(status.message(), StartsWith("calib.json: " + c.pointer + ": expected a number in"));
+    EXPECT_THAT(status.message(),
+                StartsWith("calib.json: " + c.pointer + ": expected a number in " + c.range));
   }
 }
 

@@ -145,6 +145,7 @@ TEST(ReadWholeFile, TakesRegularFilesOnlyWithinALimit) {
   ASSERT_FALSE(loop.ok());
   EXPECT_THAT(loop.status().message(), HasSubstr("symbolic link loop"));
   EXPECT_EQ(ReadWholeFile(scratch / "missing").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(kMaxWholeFileBytes, std::uintmax_t{1} << 30);  // docs/cli.md: 1 GiB
 }
 
 }  // namespace
