@@ -3,7 +3,14 @@
 // deep JSON, huge files and bad flags. Each case asserts the exit code, that the message
 // names the culprit, and that no file in the scratch folder changed (inputs and earlier
 // outputs alike) and none was left behind.
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <filesystem>
 #include <functional>
@@ -357,6 +364,62 @@ TEST(HostileSim, ADivergedRunIsMarkedInTheSweepAndLeftOutOfTheRange) {
   ASSERT_EQ(results["runs"].size(), 1u);
   EXPECT_EQ(results["runs"][0]["diverged"], true);
   EXPECT_EQ(results["runs"][0]["stood"], false);
+}
+
+// the names in `dir` that start with `prefix`
+std::vector<std::string> NamesStartingWith(const fs::path& dir, const std::string& prefix) {
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0) names.push_back(name);
+  }
+  return names;
+}
+
+// Ctrl-C while `log --convert` writes: the signal arrives while the temporary file exists
+// (watched for), the process dies of it, and neither the temporary file nor a half output
+// is left.
+TEST(HostileLog, CtrlCWhileConvertingLeavesNoTemporaryFile) {
+  ScratchDir scratch;
+  std::string log = kLiftoffLogHeader;
+  for (int64_t i = 0; i < 2'000'000; ++i) {
+    log += std::to_string(i * 1'000'000) + ",1700000000000000000,7,1,12345,67890,0.25,0.5,0.125,,\n";
+  }
+  WriteFile(scratch / "big.csv", log);
+  const fs::path output = scratch / "converted.csv";
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int null_fd = open("/dev/null", O_WRONLY);
+    dup2(null_fd, STDOUT_FILENO);
+    dup2(null_fd, STDERR_FILENO);
+    const std::string log_path = (scratch / "big.csv").string(), out_path = output.string();
+    execl(LIFTOFF_BINARY, LIFTOFF_BINARY, "log", log_path.c_str(), "--convert", out_path.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // interrupt as soon as the temporary file shows up
+  bool interrupted = false;
+  int status = 0;
+  for (int polls = 0; polls < 600'000; ++polls) {
+    if (!NamesStartingWith(scratch.path(), "converted.csv.tmp").empty()) {
+      kill(child, SIGINT);
+      interrupted = true;
+      break;
+    }
+    if (waitpid(child, &status, WNOHANG) == child) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+  if (interrupted) {
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+  }
+  if (!interrupted || (WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+    GTEST_SKIP() << "the conversion finished before the signal arrived; nothing to check";
+  }
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit " << WEXITSTATUS(status);
+  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  EXPECT_THAT(NamesStartingWith(scratch.path(), "converted.csv"), ::testing::IsEmpty());
 }
 
 TEST(HostileSync, WarnsWhenALiftoffLogHasNoLedEvent) {
