@@ -251,6 +251,20 @@ const std::vector<HostileCase>& Cases() {
        "log @/long.csv", 5, {"long.csv:4", "at most 4096 bytes"}},
       {"empty calibration", [](const ScratchDir& s) { WriteFile(s / "empty.json", ""); },
        "calib @/empty.json", 5, {"empty.json"}},
+      {"empty manifest", [](const ScratchDir& s) { WriteFile(s / "empty.json", ""); },
+       "table @/empty.json", 5, {"empty.json:1:1"}},
+      {"binary model",
+       [](const ScratchDir& s) { WriteFile(s / "bin.json", std::string("\x00\x01\x02", 3)); },
+       "sim run --model @/bin.json --progress off", 5, {"bin.json:1:1", "invalid JSON"}},
+      {"simulation results nested 100000 deep",
+       [](const ScratchDir& s) {
+         OneTrial(s);
+         WriteFile(s / "deep.json", DeepJson(100000));
+       },
+       "table @/manifest.json --sim @/deep.json", 5, {"deep.json:1:65", "nested deeper"}},
+      {"2018 log with inf",
+       [](const ScratchDir& s) { WriteFile(s / "l18.txt", "0,0.1,\r100,inf,\r200,0.3,\r"); },
+       "log @/l18.txt", 5, {"l18.txt:2", "inf"}},
       {"binary log",
        [](const ScratchDir& s) { WriteFile(s / "bin.csv", std::string("\x00\x01\xff\xfe", 4)); },
        "log @/bin.csv", 5, {"bin.csv"}},
