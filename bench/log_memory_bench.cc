@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "liftoff/core/controller_log.h"
 
 namespace {
@@ -53,13 +54,8 @@ long long PeakRssBytes(const std::vector<std::string>& arguments) {
     ::execv(LIFTOFF_BINARY, argv.data());
     ::_exit(127);
   }
-  int status = 0;
-  rusage usage{};
-  if (child < 0 || ::wait4(child, &status, 0, &usage) != child || !WIFEXITED(status) ||
-      WEXITSTATUS(status) != 0) {
-    return -1;
-  }
-  return static_cast<long long>(usage.ru_maxrss) * 1024;
+  const long peak_kib = liftoff::bench::WaitForPeakKib(child);
+  return peak_kib < 0 ? -1 : static_cast<long long>(peak_kib) * 1024;
 }
 
 double Mb(long long bytes) { return static_cast<double>(bytes) / 1e6; }
