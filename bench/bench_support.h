@@ -1,6 +1,9 @@
 // What the benchmarks share.
 #pragma once
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <cstdlib>
 
@@ -17,6 +20,18 @@ inline Calibration ShippedCalibration() {
     std::exit(1);
   }
   return *calibration;
+}
+
+/// Waits for the forked `child` and returns its peak resident memory, KiB; -1 when the fork
+/// failed or the child did not exit with status 0.
+inline long WaitForPeakKib(pid_t child) {
+  int status = 0;
+  rusage usage{};
+  if (child < 0 || ::wait4(child, &status, 0, &usage) != child || !WIFEXITED(status) ||
+      WEXITSTATUS(status) != 0) {
+    return -1;
+  }
+  return usage.ru_maxrss;
 }
 
 }  // namespace liftoff::bench

@@ -169,13 +169,7 @@ long ChildPeakKib(const char* self, const BenchClip& clip, bool decode_only) {
     }
     ::_exit(127);
   }
-  int status = 0;
-  rusage usage{};
-  if (child < 0 || ::wait4(child, &status, 0, &usage) != child || !WIFEXITED(status) ||
-      WEXITSTATUS(status) != 0) {
-    return -1;
-  }
-  return usage.ru_maxrss;
+  return bench::WaitForPeakKib(child);
 }
 
 Status RenderClips() {

@@ -14,20 +14,14 @@
 #include "liftoff/capture/protocol.h"
 #include "liftoff/capture/wire_format.h"
 
+#include "fuzz_check.h"
+
 namespace {
 
 using liftoff::capture::FrameParser;
 using liftoff::capture::ParserStats;
 using liftoff::capture::ReceivedFrame;
 namespace wire = liftoff::wire;
-
-#define FUZZ_CHECK(condition)                                                                \
-  do {                                                                                       \
-    if (!(condition)) {                                                                      \
-      std::fprintf(stderr, "%s:%d: invariant broken: %s\n", __FILE__, __LINE__, #condition); \
-      std::abort();                                                                          \
-    }                                                                                        \
-  } while (false)
 
 bool SameFrame(const wire::Frame& a, const wire::Frame& b) {
   if (a.type != b.type) return false;

@@ -2,6 +2,7 @@
 
 #include <ostream>
 
+#include "liftoff/capture/laika2018.h"
 #include "liftoff/capture/log_loader.h"
 
 namespace liftoff::cli {
@@ -40,7 +41,14 @@ Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange
                               " s, got " + FormatNumber(value_s));
 }
 
+Status CheckMaxBadLinesFlag(int64_t max_bad_lines) {
+  if (max_bad_lines >= 0) return Status::Ok();
+  return InvalidArgumentError("--max-bad-lines: expected an integer >= 0, got " +
+                              std::to_string(max_bad_lines));
+}
+
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
+  LIFTOFF_RETURN_IF_ERROR(CheckMaxBadLinesFlag(choice.max_bad_lines));
   sync::LookupOptions options;
   const auto rule = sync::ParseLookupRule(choice.rule);
   if (!rule) {
@@ -70,6 +78,38 @@ Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std
     }
   }
   return capture::LoadControllerLog(path, *parsed, calibration, options);
+}
+
+Result<TrialManifest> LoadTrials(const std::filesystem::path& path, std::ostream& err) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(path, error)) return LoadManifest(path);
+  if (!std::filesystem::exists(path / capture::kLaika2018TimesCsv, error)) {
+    return InvalidArgumentError(path.string() + ": is a folder without \"" +
+                                capture::kLaika2018TimesCsv +
+                                "\"; expected a trial manifest (JSON) or a 2018 Laika folder");
+  }
+  auto imported = capture::ImportLaika2018Folder(path, path / "manifest.json");
+  if (!imported.ok()) return imported.status();
+  for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
+  return std::move(imported->manifest);
+}
+
+std::vector<NamedPath> TrialInputs(const TrialManifest& manifest) {
+  std::vector<NamedPath> inputs;
+  if (manifest.calibration_path) {
+    inputs.push_back({"the manifest's calibration", *manifest.calibration_path});
+  }
+  for (const TrialRecord& trial : manifest.trials) {
+    inputs.push_back({"trial " + trial.id + "'s log", trial.log_path});
+    if (trial.video_path) inputs.push_back({"trial " + trial.id + "'s video", *trial.video_path});
+  }
+  return inputs;
+}
+
+int RefuseToOverwriteInputs(const std::vector<NamedPath>& outputs,
+                            const std::vector<NamedPath>& inputs, std::ostream& err) {
+  const Status checked = CheckOutputsAreNotInputs(outputs, inputs);
+  return checked.ok() ? kExitOk : ReportError(checked, err);
 }
 
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err) {

@@ -12,6 +12,7 @@
 #include "liftoff/core/controller_log.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
+#include "liftoff/core/output.h"
 #include "liftoff/sync/lookup.h"
 
 namespace liftoff::cli {
@@ -25,6 +26,9 @@ Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
 /// "--max-past-end: expected a number in [0, 1e+06] s, got 1e+10".
 Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange& range);
 
+/// OK when `--max-bad-lines` is >= 0, else kInvalidArgument naming the flag.
+Status CheckMaxBadLinesFlag(int64_t max_bad_lines);
+
 /// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);
 
@@ -32,6 +36,18 @@ Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);
 /// DetectLogFormat (liftoff logs start with "# liftoff-log", after an optional BOM).
 Result<ControllerLog> LoadLogByName(const std::filesystem::path& path, const std::string& format,
                                     const Calibration& calibration, const LogReadOptions& options);
+
+/// A manifest file, or a 2018 Laika folder imported on the fly (warnings to `err`).
+Result<TrialManifest> LoadTrials(const std::filesystem::path& path, std::ostream& err);
+
+/// The files a manifest's trials read, each named for messages: every trial's log
+/// ("trial T1's log") and video, and the manifest's calibration.
+std::vector<NamedPath> TrialInputs(const TrialManifest& manifest);
+
+/// The output policy (liftoff/core/output.h) at a command's edge: prints the error of
+/// CheckOutputsAreNotInputs and returns its exit code; kExitOk when no output is an input.
+int RefuseToOverwriteInputs(const std::vector<NamedPath>& outputs,
+                            const std::vector<NamedPath>& inputs, std::ostream& err);
 
 /// Prints each line of a log's read report that a person should see ("warning: ...").
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err);

@@ -37,20 +37,6 @@ int Emit(const std::string& text, const std::filesystem::path& output_path, std:
   return kExitOk;
 }
 
-// A manifest file, or a 2018 Laika folder imported on the fly (warnings to `err`).
-Result<TrialManifest> LoadTrials(const std::filesystem::path& path, std::ostream& err) {
-  if (!std::filesystem::is_directory(path)) return LoadManifest(path);
-  if (!std::filesystem::exists(path / capture::kLaika2018TimesCsv)) {
-    return InvalidArgumentError(path.string() + ": is a folder without \"" +
-                                capture::kLaika2018TimesCsv +
-                                "\"; expected a trial manifest (JSON) or a 2018 Laika folder");
-  }
-  auto imported = capture::ImportLaika2018Folder(path, path / "manifest.json");
-  if (!imported.ok()) return imported.status();
-  for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
-  return std::move(imported->manifest);
-}
-
 // the two instants from the command line: both, bounded so they convert to nanoseconds
 Result<EventTimes> TimesFromFlags(const SyncCommand& command) {
   if (!command.led_on_s || !command.liftoff_s) {
@@ -69,6 +55,32 @@ Result<EventTimes> TimesFromFlags(const SyncCommand& command) {
   times.liftoff_uncertainty_ns = times.led_on_uncertainty_ns;
   times.source = "command line";
   return times;
+}
+
+// what `table` writes: the tables, the plot, a verification image per trial with a video
+std::vector<NamedPath> TableOutputs(const TableCommand& command, const TrialManifest& manifest) {
+  std::vector<NamedPath> outputs = {{"--output", command.output_path},
+                                    {"--plot", command.plot_path}};
+  if (command.verify_dir.empty()) return outputs;
+  for (const TrialRecord& trial : manifest.trials) {
+    if (!trial.video_path) continue;
+    outputs.push_back({"--verify-dir", TrialVerificationPath(command.verify_dir, trial.id)});
+  }
+  return outputs;
+}
+
+// what `table` reads: the manifest (or the 2018 folder's times), the calibration, the
+// simulation results, every trial's log and video
+std::vector<NamedPath> TableInputs(const TableCommand& command, const TrialManifest& manifest,
+                                   const Calibration& calibration) {
+  std::vector<NamedPath> inputs = TrialInputs(manifest);
+  std::error_code error;
+  inputs.push_back({"MANIFEST", std::filesystem::is_directory(command.manifest_path, error)
+                                    ? command.manifest_path / capture::kLaika2018TimesCsv
+                                    : command.manifest_path});
+  inputs.push_back({"calibration", calibration.source_path});
+  inputs.push_back({"--sim", command.sim_path});
+  return inputs;
 }
 
 }  // namespace
@@ -100,6 +112,12 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   auto calibration = ChooseCalibration(
       command.calibration, manifest->calibration_path.value_or(std::filesystem::path()));
   if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (const int refused = RefuseToOverwriteInputs(TableOutputs(command, *manifest),
+                                                  TableInputs(command, *manifest, *calibration),
+                                                  err);
+      refused != kExitOk) {
+    return refused;
+  }
   std::optional<stats::SimResults> sim = command.sim_results;
   if (!sim && !command.sim_path.empty()) {
     auto loaded = stats::LoadSimResults(command.sim_path);
@@ -177,13 +195,22 @@ int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostr
   if (command.output_path.empty()) {
     return ReportError(InvalidArgumentError("--output: name the manifest file to write"), err);
   }
-  if (std::filesystem::exists(command.output_path) && !command.force) {
+  auto imported = capture::ImportLaika2018Folder(command.folder, command.output_path);
+  if (!imported.ok()) return ReportError(imported.status(), err);
+  // never onto the folder's own files, --force or not
+  std::vector<NamedPath> inputs = TrialInputs(imported->manifest);
+  inputs.push_back({"FOLDER's times", command.folder / capture::kLaika2018TimesCsv});
+  if (const int refused =
+          RefuseToOverwriteInputs({{"--output", command.output_path}}, inputs, err);
+      refused != kExitOk) {
+    return refused;
+  }
+  std::error_code error;
+  if (std::filesystem::exists(command.output_path, error) && !command.force) {
     return ReportError(InvalidArgumentError(command.output_path.string() +
                                             ": exists; pass --force to overwrite it"),
                        err);
   }
-  auto imported = capture::ImportLaika2018Folder(command.folder, command.output_path);
-  if (!imported.ok()) return ReportError(imported.status(), err);
   for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
   const Status written = WriteManifest(command.output_path, imported->manifest);
   if (!written.ok()) return ReportError(written, err);
@@ -238,6 +265,14 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   LogReadOptions read_options;
   read_options.max_bad_lines = command.lookup.max_bad_lines;
+  if (const int refused = RefuseToOverwriteInputs(
+          {{"--verify", command.verify_path}},
+          {{"LOG", command.log_path}, {"--video", command.video_path},
+           {"calibration", calibration->source_path}},
+          err);
+      refused != kExitOk) {
+    return refused;
+  }
   auto log = LoadLogByName(command.log_path, command.log_format, *calibration, read_options);
   if (!log.ok()) return ReportError(log.status(), err);
   PrintLogWarnings(log->report, err);
@@ -312,8 +347,16 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
   const Status gap_checked = CheckSecondsFlag("--gap-threshold", command.gap_threshold_s,
                                               sync::LookupOptions::kGapThresholdRange);
   if (!gap_checked.ok()) return ReportError(gap_checked, err);
+  const Status bad_lines_checked = CheckMaxBadLinesFlag(command.max_bad_lines);
+  if (!bad_lines_checked.ok()) return ReportError(bad_lines_checked, err);
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (const int refused = RefuseToOverwriteInputs(
+          {{"--convert", command.convert_path}},
+          {{"LOG", command.log_path}, {"calibration", calibration->source_path}}, err);
+      refused != kExitOk) {
+    return refused;
+  }
   LogReadOptions read_options;
   read_options.max_bad_lines = command.max_bad_lines;
   auto log = LoadLogByName(command.log_path, command.log_format, *calibration, read_options);

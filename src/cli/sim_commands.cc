@@ -147,10 +147,13 @@ Status RenameFields(const Status& status) {
   return status.WithContext("simulation options");
 }
 
+// the model file a command reads: --model, else the bundled one
+std::filesystem::path ModelPath(const SimExperimentChoice& choice) {
+  return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
+}
+
 Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice) {
-  const std::filesystem::path path =
-      choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
-  return sim::LoadModelDescription(path);
+  return sim::LoadModelDescription(ModelPath(choice));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -280,7 +283,12 @@ json RunToJson(const sim::ExperimentResult& result, const sim::Model& model,
             {"buna_n_n_per_m", tension.buna_n_n_per_m},
             {"spring_n_per_m", tension.spring_n_per_m}}},
           {"status", sim::RunStatusName(result.status)},
-          {"stood", result.status != sim::RunStatus::kDidNotStand},
+          {"stood", result.status != sim::RunStatus::kDidNotStand &&
+                        result.status != sim::RunStatus::kDiverged},
+          {"diverged_at_s",
+           result.status == sim::RunStatus::kDiverged ? json(result.diverged_at_s) : json()},
+          {"diverged_reason",
+           result.diverged_reason.empty() ? json() : json(result.diverged_reason)},
           {"not_standing_reason",
            result.not_standing_reason.empty() ? json() : json(result.not_standing_reason)},
           {"first_foot", result.first_foot ? json(FootName(*result.first_foot)) : json()},
@@ -303,6 +311,11 @@ void PrintRun(const sim::ExperimentResult& result, const sim::Model& model,
       << RotationSenseName(result.motion.rotation) << "; tension point " << TensionText(tension)
       << "\n";
   out << "result: " << result.Brief() << "\n\n";
+  if (result.status == sim::RunStatus::kDiverged) {
+    out << "The engine diverged: nothing of the run is a result. Try a smaller --dt, less "
+           "--damping or softer cables.\n";
+    return;
+  }
   out << "| Foot | Liftoff (rad) | At (s) | Height at " << FormatNumber(options.reference_time_s)
       << " s (mm) |\n| --- | ---: | ---: | ---: |\n";
   for (Foot foot : kAllFeet) {
@@ -324,12 +337,24 @@ void PrintRun(const sim::ExperimentResult& result, const sim::Model& model,
 }
 
 std::string Cell(const sim::SweepRun& run) {
+  if (run.result.status == sim::RunStatus::kDiverged) return "diverged";
   if (!run.Stood()) return "no stand";
   if (auto value = run.LiftoffRad()) {
     const bool first = run.result.first_foot == run.foot;
     return FormatFixed(*value, 3) + (first ? "" : " *");
   }
   return "none";
+}
+
+// true when a run diverged, each such run said on `err`
+bool AnyRunDiverged(const sim::SweepResult& sweep, std::ostream& err) {
+  bool any = false;
+  for (const sim::SweepRun& run : sweep.runs) {
+    if (run.result.status != sim::RunStatus::kDiverged) continue;
+    err << "liftoff: " << run.Brief() << '\n';
+    any = true;
+  }
+  return any;
 }
 
 void PrintSweep(const sim::SweepResult& sweep, std::ostream& out) {
@@ -359,8 +384,9 @@ void PrintSweep(const sim::SweepResult& sweep, std::ostream& out) {
     }
   }
   out << "\nAbsolute rotation of the rotating vertebra when the targeted foot lifted. "
-         "no stand: the robot did not stand (left out of min/max); none: the foot did not "
-         "lift; *: another foot lifted first.\n";
+         "no stand: the robot did not stand (left out of min/max); diverged: the engine "
+         "diverged (left out of min/max); none: the foot did not lift; *: another foot lifted "
+         "first.\n";
   std::vector<std::string> notes;
   for (const sim::SweepRun& run : sweep.runs) {
     if (!run.Stood() || !run.LiftoffRad() || run.result.first_foot != run.foot) {
@@ -575,6 +601,12 @@ int RunSimRun(const SimRunCommand& command, std::ostream& out, std::ostream& err
   options->tension_point = *tension;
   auto progress = SimProgress::Create(command.experiment.progress, err);
   if (!progress.ok()) return ReportError(progress.status(), err);
+  if (const int refused =
+          RefuseToOverwriteInputs({{"--curves", command.curves_path}},
+                                  {{"--model", ModelPath(command.experiment)}}, err);
+      refused != kExitOk) {
+    return refused;
+  }
   auto description = LoadDescription(command.experiment);
   if (!description.ok()) return ReportError(description.status(), err);
   auto model = sim::BuildExperimentModel(*description, *options);
@@ -607,6 +639,10 @@ int RunSimRun(const SimRunCommand& command, std::ostream& out, std::ostream& err
   }
   err << "sim: " << FormatFixed(result->end_time_s, 2) << " s simulated in "
       << FormatFixed(wall_s, 2) << " s wall\n";
+  if (result->status == sim::RunStatus::kDiverged) {
+    err << "liftoff: " << result->Brief() << '\n';
+    return kExitDiverged;
+  }
   return kExitOk;
 }
 
@@ -628,6 +664,7 @@ stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string
     entry.tension_point = run.tension_point.name;
     entry.liftoff_rad = value;
     entry.stood = run.Stood();
+    entry.diverged = run.result.status == sim::RunStatus::kDiverged;
     entry.pulled_group = run.result.motion.pulled_group;
     entry.rotation = run.result.motion.rotation;
     entry.notes = run.Brief();
@@ -697,6 +734,21 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
   auto description = LoadDescription(command.experiment);
   if (!description.ok()) return ReportError(description.status(), err);
 
+  // the hardware trials are read before the sweep: a missing or broken manifest fails in
+  // a second, not after the whole sweep
+  if (!command.hardware_path.empty()) {
+    std::ostringstream warnings;  // the table reads it again and prints them then
+    auto hardware = LoadTrials(command.hardware_path, warnings);
+    if (!hardware.ok()) return ReportError(hardware.status().WithContext("--hardware"), err);
+  }
+  if (const int refused = RefuseToOverwriteInputs(
+          {{"--output", command.output_path}},
+          {{"--model", ModelPath(command.experiment)}, {"--hardware", command.hardware_path}},
+          err);
+      refused != kExitOk) {
+    return refused;
+  }
+
   // the sweep
   const int64_t started_ns = MonotonicNowNs();
   auto sweep = sim::RunSweep(*description, options, [&](const sim::SweepProgress& report) {
@@ -724,7 +776,8 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
   } else {
     PrintSweep(*sweep, out);
   }
-  if (command.hardware_path.empty()) return kExitOk;
+  const int ran = AnyRunDiverged(*sweep, err) ? kExitDiverged : kExitOk;
+  if (command.hardware_path.empty()) return ran;
 
   // hardware beside simulation, by the table command's own code
   TableCommand table;
@@ -735,7 +788,8 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
   table.tables = "feet";
   table.sim_results = std::move(results);
   if (!command.json) out << '\n';
-  return RunTable(table, out, err);
+  const int tabulated = RunTable(table, out, err);
+  return tabulated != kExitOk ? tabulated : ran;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -768,6 +822,13 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
   if (command.output_path.empty()) {
     return ReportError(InvalidArgumentError("--output: expected a file name (or - for stdout)"),
                        err);
+  }
+
+  if (const int refused =
+          RefuseToOverwriteInputs({{"--output", command.output_path}},
+                                  {{"--model", ModelPath(command.experiment)}}, err);
+      refused != kExitOk) {
+    return refused;
   }
 
   // the model: as written, or the experiment's at a foot and tension point

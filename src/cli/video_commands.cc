@@ -218,6 +218,12 @@ int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) 
   if (!options.ok()) return ReportError(options.status(), err);
   auto progress = VideoProgress::Create(command.progress, err);
   if (!progress.ok()) return ReportError(progress.status(), err);
+  if (const int refused = RefuseToOverwriteInputs(
+          {{"--verify", command.verify_path}, {"--annotate", command.annotate_path}},
+          {{"CLIP", command.video_path}}, err);
+      refused != kExitOk) {
+    return refused;
+  }
   auto analysis = AnalyzeClipShowingProgress(command.video_path, *options, *progress);
   if (!analysis.ok()) return ReportError(analysis.status(), err);
 
@@ -258,13 +264,18 @@ int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) 
 // ---------------------------------------------------------------------------------------
 // liftoff table's verification images
 
+std::filesystem::path TrialVerificationPath(const std::filesystem::path& dir,
+                                           const std::string& trial_id) {
+  return dir / (FileStem(trial_id) + ".png");
+}
+
 Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
                                const std::filesystem::path& dir, std::ostream& err) {
   Status first_failure;
   for (const sync::TrialOutcome& outcome : analysis.outcomes) {
     if (!outcome.video) continue;
     video::VerificationOptions options;
-    options.image_path = dir / (FileStem(outcome.trial.id) + ".png");
+    options.image_path = TrialVerificationPath(dir, outcome.trial.id);
     auto written = video::WriteVerification(*outcome.video, options);
     if (!written.ok()) {
       const Status failure = written.status().WithContext(outcome.trial.id);

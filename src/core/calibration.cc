@@ -23,13 +23,18 @@ constexpr int64_t kFormatVersion = 1;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // Allowed values. Validate() checks them; docs/calibration.md lists them.
-constexpr NumberRange kPositive{.min = 0.0, .min_exclusive = true};
-constexpr NumberRange kNonNegative{.min = 0.0};
 // A groove radius above 0.1 m, or a cable above 10 m, is almost always millimetres
 // written as metres.
 constexpr NumberRange kGrooveRadius{.min = 0.0, .max = 0.1, .min_exclusive = true};
 constexpr NumberRange kCableLength{.min = 0.0, .max = 10.0, .min_exclusive = true};
 constexpr NumberRange kSigma{.min = -10.0, .max = 10.0};
+// Physical ranges, not only signs: a ratio of 1e-320 is positive but turns every angle
+// into infinity. Encoders have 1 to millions of counts per revolution; gear ratios lie
+// between 1:100 and 100000:1; cable materials lie between 1e-3 and 1e7 N/m.
+constexpr NumberRange kCountsPerRev{.min = 1.0, .max = 1e7};
+constexpr NumberRange kGearRatio{.min = 0.01, .max = 1e5};
+constexpr NumberRange kStiffness{.min = 1e-3, .max = 1e7};
+constexpr NumberRange kStiffnessSpread{.min = 0.0, .max = 1e7};
 
 // Collects the first problem, named by the field's JSON pointer in the file format.
 class Checker {
@@ -62,9 +67,10 @@ Status Calibration::Validate() const {
   // name and the drive chain
   if (name.empty()) check.Fail("/name", "expected a non-empty name");
   if (name.find_first_of("\r\n") != std::string::npos) check.Fail("/name", "expected one line");
-  check.Number("/motor/encoder_counts_per_motor_rev", encoder_counts_per_motor_rev, kPositive);
-  check.Number("/motor/gearbox_ratio", gearbox_ratio, kPositive);
-  check.Number("/rotating_vertebra/spur_gear_ratio", spur_gear_ratio, kPositive);
+  check.Number("/motor/encoder_counts_per_motor_rev", encoder_counts_per_motor_rev,
+               kCountsPerRev);
+  check.Number("/motor/gearbox_ratio", gearbox_ratio, kGearRatio);
+  check.Number("/rotating_vertebra/spur_gear_ratio", spur_gear_ratio, kGearRatio);
 
   // the bending spool
   for (size_t i = 0; i < kSpoolGrooves; ++i) {
@@ -82,9 +88,9 @@ Status Calibration::Validate() const {
     if (!material_names.insert(material.name).second) {
       check.Fail(where + "/name", "material \"" + material.name + "\" is listed twice");
     }
-    check.Number(where + "/stiffness_n_per_m", material.stiffness_n_per_m, kPositive);
+    check.Number(where + "/stiffness_n_per_m", material.stiffness_n_per_m, kStiffness);
     check.Number(where + "/stiffness_stddev_n_per_m", material.stiffness_stddev_n_per_m,
-                 kNonNegative);
+                 kStiffnessSpread);
   }
 
   // tension points: named once each, in order low .. high
@@ -98,9 +104,9 @@ Status Calibration::Validate() const {
       check.Fail(where + "/name", "tension point \"" + point.name + "\" is listed twice");
     }
     check.Number(where + "/sigma", point.sigma, kSigma);
-    check.Number(where + "/silicone_n_per_m", point.silicone_n_per_m, kPositive);
-    check.Number(where + "/buna_n_n_per_m", point.buna_n_n_per_m, kPositive);
-    check.Number(where + "/spring_n_per_m", point.spring_n_per_m, kPositive);
+    check.Number(where + "/silicone_n_per_m", point.silicone_n_per_m, kStiffness);
+    check.Number(where + "/buna_n_n_per_m", point.buna_n_n_per_m, kStiffness);
+    check.Number(where + "/spring_n_per_m", point.spring_n_per_m, kStiffness);
     if (i == 0) continue;
     // the lattice stiffens with sigma, so both elastomers must rise (or stay) with it
     const TensionPoint& previous = tension_points[i - 1];

@@ -79,6 +79,24 @@ bool HasLineBreak(std::string_view text) {
   return text.find_first_of("\r\n") != std::string_view::npos;
 }
 
+// The number of line ends (LF, or CR where a file has no LF) in a file: an upper bound of
+// its rows; 0 when it cannot be read (the reader then finds out why).
+size_t CountLineEnds(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<char, 1 << 16> buffer{};
+  size_t line_feeds = 0, carriage_returns = 0;
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto end = buffer.begin() + in.gcount();
+    line_feeds += static_cast<size_t>(std::count(buffer.begin(), end, '\n'));
+    carriage_returns += static_cast<size_t>(std::count(buffer.begin(), end, '\r'));
+  }
+  return line_feeds > 0 ? line_feeds : carriage_returns;
+}
+
+// The longest log line read whole, bytes (a liftoff row is about 100).
+constexpr size_t kMaxLineBytes = 4096;
+
 // Lines of a stream, ending in LF, CR or CRLF; reads in blocks so memory stays flat.
 class LineReader {
  public:
@@ -100,7 +118,10 @@ class LineReader {
       const char* begin = buffer_.data() + position_;
       const char* end = buffer_.data() + size_;
       const char* stop = std::find_if(begin, end, [](char c) { return c == '\n' || c == '\r'; });
-      line.append(begin, stop);
+      // a line beyond the limit keeps its first kMaxLineBytes + 1 bytes: memory stays flat
+      // on a file without line ends, and the row is reported as too long
+      const size_t room = kMaxLineBytes + 1 - std::min(line.size(), kMaxLineBytes + 1);
+      line.append(begin, begin + std::min(room, static_cast<size_t>(stop - begin)));
       position_ = static_cast<size_t>(stop - buffer_.data());
       if (stop == end) continue;
       skip_lf_ = *stop == '\r';
@@ -168,9 +189,15 @@ bool ParseInteger(std::string_view text, Integer& value) {
   return error == std::errc() && end == text.data() + text.size();
 }
 
+// a finite number ("inf" and "nan" are not angles)
 bool ParseAngle(std::string_view text, double& value) {
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  return error == std::errc() && end == text.data() + text.size();
+  return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
+}
+
+// nanoseconds within +-kMaxLogTimeNs, so differences of two times cannot overflow
+bool ParseTimeNs(std::string_view text, int64_t& value) {
+  return ParseInteger(text, value) && value >= -kMaxLogTimeNs && value <= kMaxLogTimeNs;
 }
 
 // One data row, as a sample or an event; `expected` says what was wrong when neither.
@@ -199,13 +226,13 @@ void ParseRow(std::string_view line, std::vector<std::string>& fields, ParsedRow
   // times: the device's required, the host's optional
   int64_t device_time_ns = 0;
   std::optional<int64_t> host_time_ns;
-  if (!ParseInteger(fields[kDeviceTime], device_time_ns)) {
-    return bad_field(kDeviceTime, "an integer number of nanoseconds");
+  if (!ParseTimeNs(fields[kDeviceTime], device_time_ns)) {
+    return bad_field(kDeviceTime, "an integer number of nanoseconds within +-4e18");
   }
   if (!fields[kHostTime].empty()) {
     int64_t value = 0;
-    if (!ParseInteger(fields[kHostTime], value)) {
-      return bad_field(kHostTime, "an integer number of nanoseconds or nothing");
+    if (!ParseTimeNs(fields[kHostTime], value)) {
+      return bad_field(kHostTime, "an integer number of nanoseconds within +-4e18, or nothing");
     }
     host_time_ns = value;
   }
@@ -255,7 +282,9 @@ void ParseRow(std::string_view line, std::vector<std::string>& fields, ParsedRow
                                       std::pair{kRotateShaft, &sample.rotate_shaft_rad},
                                       std::pair{kVertebra, &sample.vertebra_rad}}) {
     if (fields[column].empty()) continue;
-    if (!ParseAngle(fields[column], *angle)) return bad_field(column, "a number of radians");
+    if (!ParseAngle(fields[column], *angle)) {
+      return bad_field(column, "a finite number of radians");
+    }
   }
   if (!fields[kDetail].empty()) return bad_field(kDetail, "nothing on a sample row");
 }
@@ -442,11 +471,7 @@ Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
                                         const LogReadOptions& options) {
   const std::string name = path.string();
   if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(name);
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) return NotFoundError(name + ": no such file");
-  if (std::filesystem::is_directory(path, error)) {
-    return InvalidArgumentError(name + ": is a directory, expected a controller log");
-  }
+  LIFTOFF_RETURN_IF_ERROR(CheckRegularFile(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return IoError(name + ": cannot open for reading");
 
@@ -513,7 +538,10 @@ Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
   }
   if (!have_columns) return empty_log();
 
-  // rows: samples and events; bad ones skipped, counted and remembered
+  // rows: samples and events; bad ones skipped, counted and remembered. The samples are
+  // reserved once for every line ahead (a cheap pass over the file), so the vector never
+  // holds an old and a doubled copy at once
+  log.samples.reserve(CountLineEnds(path));
   LogReadReport& report = log.report;
   std::string first_bad;  // "file:line: expected ..., got ..." of the first bad line
   const auto skip = [&](int64_t line_number, std::string reason, bool truncated) {
@@ -532,6 +560,11 @@ Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
     if (Trim(line).empty() || Trim(line).front() == '#') continue;
     ++report.lines_total;
     const int64_t line_number = lines.line_number(has_line_end);
+    if (line.size() > kMaxLineBytes) {
+      skip(line_number, "expected a line of at most " + std::to_string(kMaxLineBytes) +
+                            " bytes, got a longer one", false);
+      continue;
+    }
     ParseRow(line, fields, row);
     if (!row.expected.empty()) {
       skip(line_number, row.expected, !has_line_end);
@@ -644,11 +677,7 @@ Status WriteControllerLog(const std::filesystem::path& path, const ControllerLog
 
 Result<LogFormat> DetectLogFormat(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) return NotFoundError(name + ": no such file");
-  if (std::filesystem::is_directory(path, error)) {
-    return InvalidArgumentError(name + ": is a directory, expected a controller log");
-  }
+  LIFTOFF_RETURN_IF_ERROR(CheckRegularFile(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return IoError(name + ": cannot open for reading");
   // enough bytes for a byte-order mark and the magic

@@ -36,6 +36,37 @@ std::pair<size_t, size_t> LineColumn(std::string_view text, size_t offset) {
   return {line, column};
 }
 
+// The deepest nesting of arrays and objects a JSON file may have (liftoff's own files
+// nest 5 deep); checked before parsing, as parsing and reading recurse.
+constexpr int kMaxJsonDepth = 64;
+
+// The largest JSON file read, bytes (manifests and models are kilobytes).
+constexpr std::uintmax_t kMaxJsonFileBytes = std::uintmax_t{64} << 20;
+
+// Byte offset of the first bracket deeper than kMaxJsonDepth, or npos. Brackets inside
+// strings do not count; the syntax itself is left to the parser.
+size_t FirstTooDeep(std::string_view text) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::string_view::npos;
+}
+
 }  // namespace
 
 std::string FormatNumber(double value) {
@@ -79,6 +110,13 @@ std::string JsonPointerEscape(std::string_view key) {
 }
 
 Result<json> ParseJsonText(std::string_view text, std::string_view source_name) {
+  if (const size_t deep = FirstTooDeep(text); deep != std::string_view::npos) {
+    const auto [line, column] = LineColumn(text, deep);
+    return ParseError(std::string(source_name) + ":" + std::to_string(line) + ":" +
+                      std::to_string(column) + ": JSON nested deeper than " +
+                      std::to_string(kMaxJsonDepth) + " levels; expected at most " +
+                      std::to_string(kMaxJsonDepth));
+  }
   try {
     return json::parse(text.begin(), text.end());
   } catch (const json::parse_error& error) {
@@ -109,7 +147,7 @@ Result<json> ParseJsonText(std::string_view text, std::string_view source_name) 
 }
 
 Result<json> LoadJsonFile(const std::filesystem::path& path) {
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path, kMaxJsonFileBytes));
   return ParseJsonText(contents, path.string());
 }
 

@@ -107,6 +107,11 @@ TrialRecord ReadTrial(JsonReader& reader, const fs::path& base_dir) {
   // who it is
   trial.id = reader.String("id");
   if (!reader.failed() && trial.id.empty()) reader.Fail("id", "expected a non-empty id");
+  const auto is_control = [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; };
+  if (!reader.failed() && std::any_of(trial.id.begin(), trial.id.end(), is_control)) {
+    reader.Fail("id", "expected one line without control characters (it names files and table "
+                      "rows)");
+  }
   trial.foot = static_cast<Foot>(reader.Enum("foot", {"A", "B", "C", "D"}));
   if (auto test = reader.OptionalInteger("test", kTestNumberRange)) {
     trial.test_number = static_cast<int>(*test);

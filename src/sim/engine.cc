@@ -821,9 +821,12 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
   const int rows = BuildContactRows(model, options, state);
   do {
     AssembleSystem(model, options, state);
-    const bool positive_definite = BandCholesky(scratch.system, scratch.band);
-    assert(positive_definite && "the step's system matrix must be positive definite");
-    (void)positive_definite;
+    if (!BandCholesky(scratch.system, scratch.band)) {
+      // the options' stiffness or damping is beyond what the step resolves: NaN
+      // velocities, which the run's divergence check reports
+      scratch.velocity.setConstant(std::numeric_limits<double>::quiet_NaN());
+      break;
+    }
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& solution =
         scratch.solution;
     solution.col(0) = scratch.rhs;
@@ -853,6 +856,44 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
   }
   state.time_s += dt;
   ++state.step_count;
+}
+
+std::string DescribeDivergence(const Model& model, const State& state) {
+  for (size_t b = 0; b < state.bodies.size(); ++b) {
+    const BodyState& body = state.bodies[b];
+    const std::string name =
+        "body \"" + (b < model.bodies.size() ? model.bodies[b].name : std::to_string(b)) + "\": ";
+    if (!body.position_m.allFinite() || !body.orientation.coeffs().allFinite()) {
+      return name + "position is not finite";
+    }
+    if (!body.velocity_m_per_s.allFinite() || !body.angular_velocity_rad_per_s.allFinite()) {
+      return name + "velocity is not finite";
+    }
+    if (body.position_m.norm() > kMaxPhysicalDistance_m) {
+      return name + FormatNumber(body.position_m.norm()) + " m from the origin (at most " +
+             FormatNumber(kMaxPhysicalDistance_m) + " m is physical)";
+    }
+    if (body.velocity_m_per_s.norm() > kMaxPhysicalSpeed_m_per_s) {
+      return name + "speed " + FormatNumber(body.velocity_m_per_s.norm()) + " m/s (at most " +
+             FormatNumber(kMaxPhysicalSpeed_m_per_s) + " m/s is physical)";
+    }
+    if (body.angular_velocity_rad_per_s.norm() > kMaxPhysicalAngularSpeed_rad_per_s) {
+      return name + "angular speed " + FormatNumber(body.angular_velocity_rad_per_s.norm()) +
+             " rad/s (at most " + FormatNumber(kMaxPhysicalAngularSpeed_rad_per_s) +
+             " rad/s is physical)";
+    }
+  }
+  for (size_t h = 0; h < state.hinge_angle_rad.size(); ++h) {
+    if (!std::isfinite(state.hinge_angle_rad[h])) {
+      return "hinge " + std::to_string(h) + ": angle is not finite";
+    }
+  }
+  for (size_t c = 0; c < state.rest_length_m.size(); ++c) {
+    if (!std::isfinite(state.rest_length_m[c])) {
+      return "cable " + std::to_string(c) + ": rest length is not finite";
+    }
+  }
+  return {};
 }
 
 CableReading ReadCable(const Model& model, const State& state, int cable_index) {

@@ -61,6 +61,7 @@ std::string_view RunStatusName(RunStatus status) {
     case RunStatus::kLifted: return "lifted";
     case RunStatus::kNoLiftoff: return "no liftoff";
     case RunStatus::kDidNotStand: return "did not stand";
+    case RunStatus::kDiverged: return "diverged";
   }
   return "?";
 }
@@ -405,6 +406,10 @@ std::string ExperimentResult::Brief() const {
     out << "did not stand: " << not_standing_reason;
     return out.str();
   }
+  if (status == RunStatus::kDiverged) {
+    out << "diverged at t = " << FormatFixed(diverged_at_s, 4) << " s: " << diverged_reason;
+    return out.str();
+  }
   const FootLiftoff& target = feet[static_cast<size_t>(foot)];
   if (target.lifted) {
     out << "lifted " << FootName(foot) << " at " << FormatFixed(target.rotation_rad, 3)
@@ -462,6 +467,18 @@ Result<ExperimentResult> RunExperimentWithProgress(const ModelDescription& descr
     controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
     Step(model, options.engine, controls, state);
     state.time_s = t_s;
+    // every step, in every build type: a diverged state is an outcome, never a result
+    if (std::string diverged = DescribeDivergence(model, state); !diverged.empty()) {
+      ExperimentResult result = recorder.Finish();
+      result.status = RunStatus::kDiverged;
+      result.diverged_at_s = t_s;
+      result.diverged_reason = std::move(diverged);
+      result.first_foot.reset();
+      result.feet = {};
+      result.steps = state.step_count;
+      report(t_s);
+      return result;
+    }
     if (!procedure.IsSampleStep(step)) continue;
     recorder.Add(SampleState(model, state));
     if (recorder.CanStop()) break;

@@ -20,8 +20,18 @@ constexpr int64_t kFormatVersion = 1;
 // Two nodes closer than this are the same point (a rod's tip and a cable's node).
 constexpr double kSamePointM = 1e-9;
 
-constexpr NumberRange kPositive{.min = 0.0, .min_exclusive = true};
-constexpr NumberRange kNonNegative{.min = 0.0};
+// Physical ranges, not only signs (a stiffness of 1e-320 is positive, and one of 1e300
+// diverges any engine): sizes up to 100 m, densities up to 1e15 kg/m^3 (a point mass is a
+// tiny, very dense sphere),
+// stiffness from 1e-3 to 1e8 N/m, damping up to 1e6 N*s/m, forces up to 1e6 N, friction
+// coefficients up to 100.
+constexpr NumberRange kSize{.min = 0.0, .max = 100.0, .min_exclusive = true};
+constexpr NumberRange kHeight{.min = 0.0, .max = 100.0};
+constexpr NumberRange kDensity{.min = 0.0, .max = 1e15};
+constexpr NumberRange kStiffness{.min = 1e-3, .max = 1e8};
+constexpr NumberRange kDamping{.min = 0.0, .max = 1e6};
+constexpr NumberRange kForce{.min = 0.0, .max = 1e6};
+constexpr NumberRange kFriction{.min = 0.0, .max = 100.0};
 constexpr NumberRange kUnit{.min = 0.0, .max = 1.0};
 
 std::string Join(const std::vector<std::string>& names) {
@@ -195,8 +205,8 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
   model.description = root.OptionalString("description").value_or("");
   model.gravity_m_per_s2 = ToVec3(root.NumberArray("gravity_m_per_s2", 3));
   if (auto contact = root.OptionalObject("contact")) {
-    model.contact.friction = contact->OptionalNumber("friction", kNonNegative).value_or(0.0);
-    model.contact.spine_friction = contact->OptionalNumber("spine_friction", kNonNegative);
+    model.contact.friction = contact->OptionalNumber("friction", kFriction).value_or(0.0);
+    model.contact.spine_friction = contact->OptionalNumber("spine_friction", kFriction);
     model.contact.restitution = contact->OptionalNumber("restitution", kUnit).value_or(0.0);
     model.contact.spine_ground = contact->OptionalBoolean("spine_ground").value_or(false);
     model.contact.spine_self = contact->OptionalBoolean("spine_self").value_or(false);
@@ -210,7 +220,7 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
   }
   model.damping_cap = root.OptionalBoolean("damping_cap").value_or(true);
   model.foot_marker_height_m =
-      root.OptionalNumber("foot_marker_height_m", kNonNegative).value_or(0.0);
+      root.OptionalNumber("foot_marker_height_m", kHeight).value_or(0.0);
 
   // bodies: nodes, rods, boxes, spheres
   for (JsonReader& body_reader : root.ObjectArray("bodies")) {
@@ -236,8 +246,8 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
         rod.name = rod_reader.String("name");
         rod.from_node = rod_reader.String("from");
         rod.to_node = rod_reader.String("to");
-        rod.radius_m = rod_reader.Number("radius_m", kPositive);
-        rod.density_kg_per_m3 = rod_reader.Number("density_kg_per_m3", kNonNegative);
+        rod.radius_m = rod_reader.Number("radius_m", kSize);
+        rod.density_kg_per_m3 = rod_reader.Number("density_kg_per_m3", kDensity);
         rod.collides = rod_reader.OptionalBoolean("collides").value_or(true);
         body.rods.push_back(std::move(rod));
       }
@@ -247,8 +257,8 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
         BoxDescription box;
         box.name = box_reader.String("name");
         box.center_m = ToVec3(box_reader.NumberArray("center_m", 3));
-        box.size_m = ToVec3(box_reader.NumberArray("size_m", 3, kPositive));
-        box.density_kg_per_m3 = box_reader.Number("density_kg_per_m3", kNonNegative);
+        box.size_m = ToVec3(box_reader.NumberArray("size_m", 3, kSize));
+        box.density_kg_per_m3 = box_reader.Number("density_kg_per_m3", kDensity);
         box.collides = box_reader.OptionalBoolean("collides").value_or(true);
         body.boxes.push_back(std::move(box));
       }
@@ -258,8 +268,8 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
         SphereDescription sphere;
         sphere.name = sphere_reader.String("name");
         sphere.center_m = ToVec3(sphere_reader.NumberArray("center_m", 3));
-        sphere.radius_m = sphere_reader.Number("radius_m", kPositive);
-        sphere.density_kg_per_m3 = sphere_reader.Number("density_kg_per_m3", kNonNegative);
+        sphere.radius_m = sphere_reader.Number("radius_m", kSize);
+        sphere.density_kg_per_m3 = sphere_reader.Number("density_kg_per_m3", kDensity);
         if (auto foot = sphere_reader.OptionalEnum("foot", {"A", "B", "C", "D"})) {
           sphere.foot = static_cast<Foot>(*foot);
         }
@@ -285,9 +295,9 @@ Result<ModelDescription> ModelDescriptionFromJson(const json& document, const st
     CableGroupDescription group;
     group.name = group_reader.String("name");
     group.material = group_reader.OptionalString("material").value_or("");
-    group.stiffness_n_per_m = group_reader.Number("stiffness_n_per_m", kPositive);
-    group.damping_n_s_per_m = group_reader.Number("damping_n_s_per_m", kNonNegative);
-    group.pretension_n = group_reader.Number("pretension_n", kNonNegative);
+    group.stiffness_n_per_m = group_reader.Number("stiffness_n_per_m", kStiffness);
+    group.damping_n_s_per_m = group_reader.Number("damping_n_s_per_m", kDamping);
+    group.pretension_n = group_reader.Number("pretension_n", kForce);
     model.cable_groups.push_back(std::move(group));
   }
 
@@ -463,11 +473,11 @@ Result<Model> BuildModel(const ModelDescription& description, const std::string&
   // world settings
   check.Name("/name", description.name);
   check.Vector("/gravity_m_per_s2", description.gravity_m_per_s2);
-  check.Number("/contact/friction", description.contact.friction, kNonNegative);
+  check.Number("/contact/friction", description.contact.friction, kFriction);
   check.Number("/contact/restitution", description.contact.restitution, kUnit);
-  check.Number("/foot_marker_height_m", description.foot_marker_height_m, kNonNegative);
+  check.Number("/foot_marker_height_m", description.foot_marker_height_m, kHeight);
   if (description.contact.spine_friction) {
-    check.Number("/contact/spine_friction", *description.contact.spine_friction, kNonNegative);
+    check.Number("/contact/spine_friction", *description.contact.spine_friction, kFriction);
   }
   if (description.bodies.empty()) check.Fail("/bodies", "expected at least one body");
 
@@ -512,8 +522,8 @@ Result<Model> BuildModel(const ModelDescription& description, const std::string&
     for (size_t r = 0; r < in.rods.size(); ++r) {
       const RodDescription& rod_in = in.rods[r];
       const std::string rod_where = At(where + "/rods", r);
-      check.Number(rod_where + "/radius_m", rod_in.radius_m, kPositive);
-      check.Number(rod_where + "/density_kg_per_m3", rod_in.density_kg_per_m3, kNonNegative);
+      check.Number(rod_where + "/radius_m", rod_in.radius_m, kSize);
+      check.Number(rod_where + "/density_kg_per_m3", rod_in.density_kg_per_m3, kDensity);
       const auto from = nodes.find(rod_in.from_node);
       const auto to = nodes.find(rod_in.to_node);
       if (from == nodes.end()) {
@@ -541,9 +551,9 @@ Result<Model> BuildModel(const ModelDescription& description, const std::string&
       const std::string box_where = At(where + "/boxes", x);
       check.Vector(box_where + "/center_m", box_in.center_m);
       for (int i = 0; i < 3; ++i) {
-        check.Number(box_where + "/size_m/" + std::to_string(i), box_in.size_m[i], kPositive);
+        check.Number(box_where + "/size_m/" + std::to_string(i), box_in.size_m[i], kSize);
       }
-      check.Number(box_where + "/density_kg_per_m3", box_in.density_kg_per_m3, kNonNegative);
+      check.Number(box_where + "/density_kg_per_m3", box_in.density_kg_per_m3, kDensity);
       const MassProperties props =
           BoxMassProperties(box_in.center_m, box_in.size_m, box_in.density_kg_per_m3);
       parts.push_back(props);
@@ -554,8 +564,8 @@ Result<Model> BuildModel(const ModelDescription& description, const std::string&
       const SphereDescription& sphere_in = in.spheres[s];
       const std::string sphere_where = At(where + "/spheres", s);
       check.Vector(sphere_where + "/center_m", sphere_in.center_m);
-      check.Number(sphere_where + "/radius_m", sphere_in.radius_m, kPositive);
-      check.Number(sphere_where + "/density_kg_per_m3", sphere_in.density_kg_per_m3, kNonNegative);
+      check.Number(sphere_where + "/radius_m", sphere_in.radius_m, kSize);
+      check.Number(sphere_where + "/density_kg_per_m3", sphere_in.density_kg_per_m3, kDensity);
       const MassProperties props =
           SphereMassProperties(sphere_in.center_m, sphere_in.radius_m, sphere_in.density_kg_per_m3);
       parts.push_back(props);
@@ -666,9 +676,9 @@ Result<Model> BuildModel(const ModelDescription& description, const std::string&
       check.Fail(where + "/name", "cable group \"" + group.name + "\" is listed twice");
     }
     group_names.push_back(group.name);
-    check.Number(where + "/stiffness_n_per_m", group.stiffness_n_per_m, kPositive);
-    check.Number(where + "/damping_n_s_per_m", group.damping_n_s_per_m, kNonNegative);
-    check.Number(where + "/pretension_n", group.pretension_n, kNonNegative);
+    check.Number(where + "/stiffness_n_per_m", group.stiffness_n_per_m, kStiffness);
+    check.Number(where + "/damping_n_s_per_m", group.damping_n_s_per_m, kDamping);
+    check.Number(where + "/pretension_n", group.pretension_n, kForce);
   }
   model.cable_groups = description.cable_groups;
   if (!check.ok()) return check.status();

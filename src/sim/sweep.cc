@@ -67,7 +67,9 @@ Status SweepOptions::Validate() const {
 // ---------------------------------------------------------------------------------------
 // results
 
-bool SweepRun::Stood() const { return result.status != RunStatus::kDidNotStand; }
+bool SweepRun::Stood() const {
+  return result.status != RunStatus::kDidNotStand && result.status != RunStatus::kDiverged;
+}
 
 std::optional<double> SweepRun::LiftoffRad() const { return result.TargetLiftoffRad(); }
 
@@ -88,6 +90,7 @@ std::vector<SweepFootRange> SweepResult::Ranges() const {
     for (const SweepRun& run : runs) {
       if (run.foot != foot) continue;
       ++range.runs;
+      if (run.result.status == RunStatus::kDiverged) ++range.diverged_runs;
       const std::optional<double> value = run.LiftoffRad();
       if (!value) continue;
       range.min_rad = range.counted_runs == 0 ? *value : std::min(range.min_rad, *value);

@@ -26,6 +26,10 @@ SimRun ReadRun(JsonReader& reader) {
     reader.Fail("tension_point", "expected a non-empty name such as \"high\"");
   }
   run.stood = reader.Boolean("stood");
+  run.diverged = reader.OptionalBoolean("diverged").value_or(false);
+  if (!reader.failed() && run.diverged && run.stood) {
+    reader.Fail("diverged", "a diverged run cannot have stood (stood must be false)");
+  }
   run.liftoff_rad = reader.OptionalNumber("liftoff_rad", {.min = 0.0});
   if (!reader.failed() && run.stood && !run.liftoff_rad) {
     reader.Fail("liftoff_rad",
@@ -123,6 +127,7 @@ json SimResultsToJson(const SimResults& results) {
     json entry = {{"foot", FootName(run.foot)}, {"tension_point", run.tension_point}};
     if (run.liftoff_rad) entry["liftoff_rad"] = *run.liftoff_rad;
     entry["stood"] = run.stood;
+    if (run.diverged) entry["diverged"] = true;
     if (run.pulled_group) entry["pulled_group"] = CableGroupName(*run.pulled_group);
     if (run.rotation) entry["rotation"] = RotationSenseName(*run.rotation);
     if (!run.notes.empty()) entry["notes"] = run.notes;

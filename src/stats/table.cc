@@ -39,7 +39,8 @@ std::string MarkdownEscape(std::string_view text) {
   std::string escaped;
   for (char c : text) {
     if (c == '|') escaped += '\\';
-    escaped += c;
+    // a line break would end the table row
+    escaped += c == '\n' || c == '\r' ? ' ' : c;
   }
   return escaped;
 }
@@ -202,7 +203,9 @@ ResultsTable BuildResultsTable(std::span<const TrialValue> trials, const SimResu
       if (run.stood) continue;
       table.notes.push_back("Sim run of foot " + std::string(FootName(run.foot)) +
                             " at tension point " + run.tension_point +
-                            " did not stand; excluded from sim min/max.");
+                            (run.diverged ? " diverged (the engine's state stopped being finite)"
+                                          : " did not stand") +
+                            "; excluded from sim min/max.");
     }
   }
   for (const TrialValue& trial : trials) {

@@ -100,6 +100,18 @@ std::string AngleLookup::Brief() const {
   return text + ")";
 }
 
+namespace {
+
+// OK when |time_ns| <= kMaxLogTimeNs (readers of liftoff's format enforce it; this holds
+// for logs made in memory or read by other readers)
+Status CheckLogTime(std::string_view what, int64_t time_ns) {
+  if (time_ns >= -kMaxLogTimeNs && time_ns <= kMaxLogTimeNs) return Status::Ok();
+  return OutOfRangeError(std::string(what) + " at " + std::to_string(time_ns) +
+                         " ns: expected a time within +-4e18 ns (about 127 years)");
+}
+
+}  // namespace
+
 Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_ns,
                                         int64_t query_uncertainty_ns,
                                         const LookupOptions& options) {
@@ -120,6 +132,11 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   const auto last_sample = std::find_if(log.samples.rbegin(), log.samples.rend(), has_angle);
   const AnglePoint first{first_sample->device_time_ns, first_sample->vertebra_rad};
   const AnglePoint last{last_sample->device_time_ns, last_sample->vertebra_rad};
+  // times within +-kMaxLogTimeNs: no difference below can overflow
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's first sample", log.samples.front().device_time_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's last sample", log.samples.back().device_time_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant looked up", query_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant's uncertainty", query_uncertainty_ns));
   const std::string span =
       "(log spans " + FormatSeconds(first.time_ns) + "-" + FormatSeconds(last.time_ns) + " s)";
 
@@ -274,8 +291,12 @@ Result<LiftoffMeasurement> MeasureLiftoff(const ControllerLog& log, const EventT
       video_times.led_on_uncertainty_ns + video_times.liftoff_uncertainty_ns;
 
   // the video's LED-on is the log's LED-on (the 2018 device clock starts there)
+  const std::optional<int64_t> led_on_log_ns = log.LedOnTimeNs();
+  if (led_on_log_ns) LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's LED switch-on", *led_on_log_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the video's LED switch-on", video_times.led_on_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the video's liftoff", video_times.liftoff_ns));
   measurement.log_from_video.source_origin_ns = video_times.led_on_ns;
-  measurement.log_from_video.target_at_origin_ns = log.LedOnTimeNs().value_or(0);
+  measurement.log_from_video.target_at_origin_ns = led_on_log_ns.value_or(0);
   measurement.log_from_video.scale = 1.0;
   measurement.liftoff_log_ns = measurement.log_from_video(video_times.liftoff_ns);
 
@@ -283,6 +304,11 @@ Result<LiftoffMeasurement> MeasureLiftoff(const ControllerLog& log, const EventT
   LIFTOFF_ASSIGN_OR_RETURN(measurement.lookup,
                            LookupVertebraAngle(log, measurement.liftoff_log_ns,
                                                measurement.interval_uncertainty_ns, options));
+  if (!led_on_log_ns && log.report.format == "liftoff") {
+    // liftoff's own logs mark the LED; without the mark device time 0 is only a guess
+    measurement.lookup.warnings.push_back(
+        "the log has no LED event: device time 0 taken as the LED switch-on");
+  }
   const AngleLookup& lookup = measurement.lookup;
   measurement.liftoff_rad = std::abs(lookup.vertebra_rad);
   const bool spans_zero = lookup.lower_rad <= 0.0 && lookup.upper_rad >= 0.0;

@@ -130,20 +130,46 @@ bool IsLosslessCodec(std::string fourcc) {
   return false;
 }
 
+// A file's first bytes, for recognising what it is by its signature.
+class FileHead {
+ public:
+  explicit FileHead(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    file.read(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+    size_ = static_cast<size_t>(file.gcount());
+  }
+  // whether `text` stands at `offset`
+  bool Has(size_t offset, std::string_view text) const {
+    return size_ >= offset + text.size() &&
+           std::memcmp(bytes_.data() + offset, text.data(), text.size()) == 0;
+  }
+
+ private:
+  std::array<char, 12> bytes_{};
+  size_t size_ = 0;
+};
+
 bool LooksLikeVideoContainer(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::array<char, 12> head{};
-  file.read(head.data(), static_cast<std::streamsize>(head.size()));
-  const auto got = static_cast<size_t>(file.gcount());
-  const auto has = [&](size_t offset, const char* text) {
-    const size_t length = std::strlen(text);
-    return got >= offset + length && std::memcmp(head.data() + offset, text, length) == 0;
-  };
+  const FileHead head(path);
+  const auto has = [&](size_t offset, std::string_view text) { return head.Has(offset, text); };
   for (const char* box : {"ftyp", "moov", "mdat", "free", "skip", "wide"}) {
     if (has(4, box)) return true;
   }
   if (has(0, "\x1A\x45\xDF\xA3")) return true;
   return has(0, "RIFF") && (has(8, "AVI ") || has(8, "AVIX"));
+}
+
+// The kind of still picture the file starts like ("PNG", "JPEG", ...), or empty.
+std::string_view StillImageKind(const fs::path& path) {
+  const FileHead head(path);
+  const auto has = [&](size_t offset, std::string_view text) { return head.Has(offset, text); };
+  if (has(0, "\x89PNG\r\n\x1a\n")) return "PNG";
+  if (has(0, "\xff\xd8\xff")) return "JPEG";
+  if (has(0, "GIF87a") || has(0, "GIF89a")) return "GIF";
+  if (has(0, "BM")) return "BMP";
+  if (has(0, "II*") || has(0, std::string_view("MM\0*", 4))) return "TIFF";
+  if (has(0, "RIFF") && has(8, "WEBP")) return "WebP";
+  return {};
 }
 
 // The median of every interval of a clip in fixed memory: intervals are counted in bins
@@ -385,8 +411,12 @@ Result<VideoReader> VideoReader::Open(const fs::path& path, const Options& optio
 
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
-  if (!fs::exists(status)) return NotFoundError(impl->name + ": no such file");
   if (fs::is_directory(status)) return ParseError(impl->name + ": not a video (a folder)");
+  LIFTOFF_RETURN_IF_ERROR(CheckRegularFile(path));
+  // FFmpeg opens a still picture as a one-frame clip, whatever the file's name
+  if (const std::string_view image = StillImageKind(path); !image.empty()) {
+    return ParseError(impl->name + ": not a video (a " + std::string(image) + " picture)");
+  }
 
   const bool container = LooksLikeVideoContainer(path);
   const auto damaged = [&](const std::string& why) {

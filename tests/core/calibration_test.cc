@@ -331,14 +331,39 @@ TEST(CalibrationFile, NegativeGearboxRatioNamesPointerAndRange) {
   document["motor"]["gearbox_ratio"] = -1000;
   const Status status = FromJsonStatus(document);
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(status.message(), "calib.json: /motor/gearbox_ratio: expected a number > 0, got -1000");
+  EXPECT_EQ(status.message(),
+            "calib.json: /motor/gearbox_ratio: expected a number in [0.01, 100000], got -1000");
+}
+
+// positive is not enough: 1e-320 (a denormal) turns every angle into infinity
+TEST(CalibrationFile, RatiosAndStiffnessesOutsidePhysicalRangesAreRejected) {
+  struct Case {
+    std::string pointer;
+    double value;
+    std::string range;  // as docs/calibration.md gives it
+  };
+  for (const Case& c :
+       {Case{"/motor/gearbox_ratio", 1e-320, "[0.01, 100000]"},
+        Case{"/motor/gearbox_ratio", 1e300, "[0.01, 100000]"},
+        Case{"/rotating_vertebra/spur_gear_ratio", 1e-320, "[0.01, 100000]"},
+        Case{"/motor/encoder_counts_per_motor_rev", 0.5, "[1, 1e+07]"},
+        Case{"/materials/0/stiffness_n_per_m", 1e300, "[0.001, 1e+07]"},
+        Case{"/tension_points/0/spring_n_per_m", 1e-320, "[0.001, 1e+07]"}}) {
+    SCOPED_TRACE(c.pointer);
+    json document = ShippedJson();
+    document[json::json_pointer(c.pointer)] = c.value;
+    const Status status = FromJsonStatus(document);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+    EXPECT_THAT(status.message(),
+                StartsWith("calib.json: " + c.pointer + ": expected a number in " + c.range));
+  }
 }
 
 TEST(CalibrationFile, ZeroCountsPerRevIsRejected) {
   json document = ShippedJson();
   document["motor"]["encoder_counts_per_motor_rev"] = 0;
   EXPECT_EQ(FromJsonStatus(document).message(),
-            "calib.json: /motor/encoder_counts_per_motor_rev: expected a number > 0, got 0");
+            "calib.json: /motor/encoder_counts_per_motor_rev: expected a number in [1, 1e+07], got 0");
 }
 
 TEST(CalibrationFile, WrongTypeNamesPointer) {
@@ -443,7 +468,7 @@ TEST(CalibrationValidate, RejectsNonFiniteValues) {
   Calibration calibration = RoundCalibration();
   calibration.spur_gear_ratio = std::numeric_limits<double>::infinity();
   EXPECT_THAT(calibration.Validate().message(),
-              StartsWith("/rotating_vertebra/spur_gear_ratio: expected a number > 0"));
+              StartsWith("/rotating_vertebra/spur_gear_ratio: expected a number in [0.01, 100000]"));
   calibration = RoundCalibration();
   calibration.cable_lengths_m[1] = std::nan("");
   EXPECT_THAT(calibration.Validate().message(), StartsWith("/bending_spool/cable_lengths_m/1:"));
@@ -453,7 +478,7 @@ TEST(CalibrationValidate, RejectsNegativeStandardDeviation) {
   Calibration calibration = RoundCalibration();
   calibration.materials[0].stiffness_stddev_n_per_m = -1;
   EXPECT_EQ(calibration.Validate().message(),
-            "/materials/0/stiffness_stddev_n_per_m: expected a number >= 0, got -1");
+            "/materials/0/stiffness_stddev_n_per_m: expected a number in [0, 1e+07], got -1");
 }
 
 TEST(CalibrationValidate, RejectsDuplicateTensionPoint) {

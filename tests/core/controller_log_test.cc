@@ -247,15 +247,31 @@ TEST(ControllerLog, BadFieldErrorNamesTheColumnAndTheText) {
     std::string expected;
   };
   const Case cases[] = {
-      {"1.5,,,,,,,,,,", "device_time_ns: expected an integer number of nanoseconds, got \"1.5\""},
-      {",,,,,,,,,,", "device_time_ns: expected an integer number of nanoseconds, got \"\""},
+      {"1.5,,,,,,,,,,",
+       "device_time_ns: expected an integer number of nanoseconds within +-4e18, got \"1.5\""},
+      {",,,,,,,,,,", "device_time_ns: expected an integer number of nanoseconds within +-4e18, got \"\""},
       {"10, 5,,,,,,,,,",
-       "host_time_ns: expected an integer number of nanoseconds or nothing, got \" 5\""},
+       "host_time_ns: expected an integer number of nanoseconds within +-4e18, or nothing, got "
+       "\" 5\""},
+      // times whose differences could overflow int64
+      {"4000000000000000001,,,,,,,,,,",
+       "device_time_ns: expected an integer number of nanoseconds within +-4e18, got "
+       "\"4000000000000000001\""},
+      {"-9223372036854775808,,,,,,,,,,", "device_time_ns: expected an integer number of "
+                                          "nanoseconds within +-4e18"},
+      {"10,9223372036854775807,,,,,,,,,", "host_time_ns: expected an integer number of "
+                                          "nanoseconds within +-4e18"},
       {"10,,-1,,,,,,,,", "seq: expected an integer in [0, 4294967295], got \"-1\""},
       {"10,,4294967296,,,,,,,,", "seq: expected an integer in [0, 4294967295], got \"4294967296\""},
       {"10,,,2,,,,,,,", "led: expected 0, 1 or nothing, got \"2\""},
       {"10,,,,1e3,,,,,,", "bend_counts: expected an integer number of counts, got \"1e3\""},
-      {"10,,,,,,,0.5rad,,,", "rotate_shaft_rad: expected a number of radians, got \"0.5rad\""},
+      {"10,,,,,,,0.5rad,,,",
+       "rotate_shaft_rad: expected a finite number of radians, got \"0.5rad\""},
+      // non-finite angles are not measurements
+      {"10,,,,,,,,inf,,", "vertebra_rad: expected a finite number of radians, got \"inf\""},
+      {"10,,,,,,-nan,,,,", "bend_spool_rad: expected a finite number of radians, got \"-nan\""},
+      {"10,,,,,,,1e999,,,", "rotate_shaft_rad: expected a finite number of radians"},
+      {"10,,,,,,,,infinity,,", "vertebra_rad: expected a finite number of radians"},
       {"10,,,,,,,,0,5,,", "expected 11 comma-separated fields"},
       {"10,,,,,,,,,blink,",
        "event: expected one of led_on, led_off, test_start, test_end, gap, reconnect, fault, "

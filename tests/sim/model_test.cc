@@ -293,9 +293,34 @@ TEST(Model, NegativeStiffnessIsNamedWithItsPointer) {
   const Status status = LoadError(document);
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
   EXPECT_NE(status.message().find("tiny.json: /cable_groups/0/stiffness_n_per_m: expected a "
-                                  "number > 0, got -5"),
+                                  "number in [0.001, 1e+08], got -5"),
             std::string::npos)
       << status.message();
+}
+
+// positive is not enough: a stiffness of 1e-320 or 1e300 passes "> 0" and breaks the engine
+TEST(Model, FieldsOutsidePhysicalRangesAreNamedWithTheirPointer) {
+  struct Case {
+    std::string pointer;
+    double value;
+    std::string range;  // as docs/sim.md gives it
+  };
+  for (const Case& c :
+       {Case{"/cable_groups/0/stiffness_n_per_m", 1e-320, "[0.001, 1e+08]"},
+        Case{"/cable_groups/0/stiffness_n_per_m", 1e300, "[0.001, 1e+08]"},
+        Case{"/cable_groups/0/damping_n_s_per_m", 1e300, "[0, 1e+06]"},
+        Case{"/cable_groups/0/pretension_n", 1e300, "[0, 1e+06]"},
+        Case{"/bodies/1/spheres/0/radius_m", 1e3, "(0, 100]"},
+        Case{"/bodies/1/spheres/0/density_kg_per_m3", 1e16, "[0, 1e+15]"}}) {
+    SCOPED_TRACE(c.pointer);
+    nlohmann::json document = TinyModel();
+    document[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    const Status status = LoadError(document);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(status.message().find("tiny.json: " + c.pointer + ": expected a number in " + c.range),
+              std::string::npos)
+        << status.message();
+  }
 }
 
 TEST(Model, NotANumberIsNamedWithItsPointer) {

@@ -502,6 +502,16 @@ TEST(TrialTable, MarkdownListsEveryTrialWithInterval) {
   EXPECT_THAT(md, HasSubstr(kLookupRule));
 }
 
+TEST(TrialTable, MarkdownKeepsAnIdWithALineBreakOnItsRow) {
+  auto trials = Trials2018AD();
+  trials[1].trial_id = "A2\n| x | y |";
+  trials[1].flags = "gap\r\n0.93 s";
+  const std::string md =
+      RenderTrialTable(trials, TableFormat::kMarkdown, kCalibration, kLookupRule);
+  EXPECT_TRUE(HasLine(md, "| A2 \\| x \\| y \\| | A | 0.385 | [0.375, 0.395] | gap  0.93 s |"))
+      << md;
+}
+
 TEST(TrialTable, CsvParsesBackIncludingQuotedFlags) {
   auto trials = Trials2018AD();
   trials[0].flags = "gap 0.93 s, \"burst\"";

@@ -22,6 +22,9 @@ namespace liftoff::cli {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitInternal = 1;
 inline constexpr int kExitUsage = 2;
+/// A simulation whose engine diverged (`sim run`; `sim sweep` when any run did): an
+/// outcome, not a result (docs/cli.md).
+inline constexpr int kExitDiverged = 10;
 int ExitCodeFor(StatusCode code);
 /// Prints "liftoff: <status>" on `err` and returns its exit code.
 int ReportError(const Status& status, std::ostream& err);

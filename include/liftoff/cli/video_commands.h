@@ -68,6 +68,11 @@ Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::pa
                                                        const video::ClipAnalysisOptions& options,
                                                        VideoProgress& progress);
 
+/// The verification image of a trial: `dir`/<trial id>.png, the id made a safe file name
+/// (anything but letters, digits, '.', '_' and '-' becomes '_').
+std::filesystem::path TrialVerificationPath(const std::filesystem::path& dir,
+                                           const std::string& trial_id);
+
 /// Writes `dir`/<trial id>.png for every trial of `analysis` whose times came from its
 /// video (failed ones included, when their video analysis got through); one line per file
 /// on `err`. Returns the first error; the other images are still written.

@@ -22,6 +22,11 @@ namespace liftoff {
 
 inline constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 
+/// The largest |time| a log may hold, device or host clock, ns (4e18 ns, about 127 years):
+/// the difference of any two such times fits in int64, so no interval computed from a
+/// log can overflow. Readers reject larger times naming file:line.
+inline constexpr int64_t kMaxLogTimeNs = 4'000'000'000'000'000'000;
+
 /// One sample of the controller's stream. Fields the source did not provide are
 /// nullopt (integers) or NaN (angles).
 struct LogSample {

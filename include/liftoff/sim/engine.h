@@ -180,7 +180,21 @@ State InitialState(const Model& model, double lift_m = 0.0);
 
 /// Advances `state` by options.time_step_s. Controls are checked only by assert (sizes);
 /// options must have passed Validate().
+/// A step whose system cannot be solved (stiffness or damping beyond what the time step
+/// resolves) leaves NaN velocities, which DescribeDivergence reports.
 void Step(const Model& model, const EngineOptions& options, const Controls& controls, State& state);
+
+/// Bounds of a physical state: body origins within this distance of the world origin, m,
+/// and speeds below these (the robot is a metre across and moves at centimetres a second).
+inline constexpr double kMaxPhysicalDistance_m = 1e3;
+inline constexpr double kMaxPhysicalSpeed_m_per_s = 1e3;
+inline constexpr double kMaxPhysicalAngularSpeed_rad_per_s = 1e5;
+
+/// Empty when `state` is physical: every body's position, orientation and velocities
+/// finite and within the bounds above, every hinge angle and rest length finite. Else what
+/// is not, naming the body: "body \"pelvis\": velocity is not finite". Checked in every
+/// build type (not an assert): a diverged run is an outcome a user's options can cause.
+std::string DescribeDivergence(const Model& model, const State& state);
 
 /// One cable's current geometry and tension.
 struct CableReading {

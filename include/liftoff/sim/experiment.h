@@ -103,8 +103,12 @@ enum class RunStatus {
   /// or a body origin below the highest foot centre) at some sample from the reference
   /// time to the first liftoff: liftoff values are meaningless (kept for diagnosis only).
   kDidNotStand,
+  /// The engine diverged: some position, velocity or rest length stopped being finite (or
+  /// grew beyond any physical motion) at `diverged_at_s`. Nothing of the run is a result;
+  /// a smaller time step or less stiffness/damping is needed.
+  kDiverged,
 };
-/// "lifted", "no liftoff", "did not stand".
+/// "lifted", "no liftoff", "did not stand", "diverged".
 std::string_view RunStatusName(RunStatus status);
 
 struct ExperimentOptions {
@@ -266,6 +270,10 @@ struct ExperimentResult {
   double reference_body_point_m = 0.0;
   /// Why the robot did not stand (empty otherwise).
   std::string not_standing_reason;
+  /// With kDiverged: the simulated instant the state was found diverged, s, and what
+  /// diverged ("body 3's velocity is not finite").
+  double diverged_at_s = 0.0;
+  std::string diverged_reason;
   /// Samples from the ramp's start on, |rotation| strictly increasing.
   std::vector<CurvePoint> curve;
   /// Simulated time at the end of the run, s; steps taken.

@@ -70,7 +70,7 @@ struct SweepRun {
   /// The whole experiment's outcome (curves included, up to where the run stopped).
   ExperimentResult result;
 
-  /// Whether the robot stood (status is not kDidNotStand).
+  /// Whether the robot stood (status is neither kDidNotStand nor kDiverged).
   bool Stood() const;
   /// The targeted foot's absolute liftoff rotation, rad, when the robot stood and that
   /// foot lifted.
@@ -86,6 +86,8 @@ struct SweepFootRange {
   /// Runs of this foot, and those where the robot stood and the foot lifted.
   int runs = 0;
   int counted_runs = 0;
+  /// Runs of this foot whose engine diverged (left out of the range, reported apart).
+  int diverged_runs = 0;
   /// Smallest and largest liftoff rotation over the counted runs, rad (0 when none).
   double min_rad = 0.0;
   double max_rad = 0.0;

@@ -46,6 +46,9 @@ struct SimRun {
   std::optional<RotationSense> rotation;
   /// Free text.
   std::string notes;
+  /// Whether the run's engine diverged (then stood is false and there is no liftoff):
+  /// excluded from min/max and reported apart.
+  bool diverged = false;
 };
 
 /// The simulated range of one foot's liftoff rotation (paper Table IV's sim columns).
