@@ -259,6 +259,9 @@ Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec) {
   if (run.status == sim::RunStatus::kDidNotStand) {
     return NotFoundError("trial3d " + spec.id + ": the simulated robot does not stand: " + run.Brief());
   }
+  if (run.status == sim::RunStatus::kDiverged) {
+    return InvalidArgumentError("trial3d " + spec.id + ": the simulation diverged: " + run.Brief());
+  }
 
   // the ramp's start is the LED switch-on on the video clock
   Motion3d motion;

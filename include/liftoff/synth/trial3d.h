@@ -128,7 +128,7 @@ struct Motion3d {
 };
 
 /// Runs the simulation for `spec` and maps it onto the video clock. kInvalidArgument for a
-/// bad spec; kNotFound when the simulated robot does not stand.
+/// bad spec or a diverged simulation; kNotFound when the simulated robot does not stand.
 Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec);
 
 /// The controller's log of a trial: rows (t_ms, rotation_rad) from 0 at the LED
