@@ -11,6 +11,8 @@
 // byte for byte, and the wall time.
 //
 // Run: build/bench/capture_soak_bench   (one iteration of about half a minute)
+#include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -114,15 +116,21 @@ Sent NextFrame(int64_t k, int64_t& device_us, std::string& line) {
   return sent;
 }
 
+// Writes all of `bytes` to the non-blocking pty master; false when the pty took nothing
+// for 30 s (a capture that never reconnected leaves the pty's buffer full).
 bool WriteAll(int fd, const std::string& bytes) {
   for (size_t written = 0; written < bytes.size();) {
+    pollfd writable{fd, POLLOUT, 0};
+    if (::poll(&writable, 1, 30'000) == 0) return false;
     const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) return false;
     written += static_cast<size_t>(n);
   }
   return true;
 }
+
+void MakeNonBlocking(int fd) { ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK); }
 
 // ---------------------------------------------------------------------------------------
 // the run
@@ -135,6 +143,7 @@ struct Figures {
   int64_t lost_outside_windows = 0;
   int64_t corrupted_accepted = 0;
   int64_t reconnects_marked = 0;
+  int64_t stalled_at_frame = -1;  // the capture stopped reading here (never reconnected)
   int64_t missing_reported = 0;
   int64_t missing_expected = 0;
   int64_t replay_rows_differing = -1;
@@ -154,7 +163,8 @@ void WaitForCapture(const std::atomic<int64_t>& captured_bytes, int64_t written_
 // Sends the run through `link`, unplugging ten times; waits for the capture to have
 // every byte before each unplug, so what is lost is exactly what was sent unplugged.
 std::vector<Sent> Controller(const std::filesystem::path& link,
-                             const std::atomic<int64_t>& captured_bytes, std::string& problem) {
+                             const std::atomic<int64_t>& captured_bytes, std::string& problem,
+                             int64_t& stalled_at_frame) {
   std::vector<Sent> frames;
   frames.reserve(kFrames);
   auto opened = PseudoTerminal::Open();
@@ -163,6 +173,7 @@ std::vector<Sent> Controller(const std::filesystem::path& link,
     return frames;
   }
   PseudoTerminal pty = std::move(opened).value();
+  MakeNonBlocking(pty.master_fd());
   std::filesystem::create_symlink(pty.slave_path(), link);
   std::mt19937_64 random(12);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -173,11 +184,11 @@ std::vector<Sent> Controller(const std::filesystem::path& link,
   std::string batch;
   std::string line;
   const auto flush = [&] {
-    if (!WriteAll(pty.master_fd(), batch)) problem = "write to the pty failed";
+    if (!WriteAll(pty.master_fd(), batch)) stalled_at_frame = static_cast<int64_t>(frames.size());
     written_bytes += static_cast<int64_t>(batch.size());
     batch.clear();
   };
-  for (int64_t k = 0; k < kFrames && problem.empty(); ++k) {
+  for (int64_t k = 0; k < kFrames && problem.empty() && stalled_at_frame < 0; ++k) {
     // an unplug: the capture has every byte, then the link goes (and comes back)
     const int unplug = static_cast<int>(k * kUnplugs / kFrames);
     if (k > 0 && k == (unplug * kFrames + kFrames / 2) / kUnplugs) {
@@ -194,6 +205,7 @@ std::vector<Sent> Controller(const std::filesystem::path& link,
         break;
       }
       pty = std::move(next).value();
+      MakeNonBlocking(pty.master_fd());
       std::filesystem::create_symlink(pty.slave_path(), link);
       unplugged_until = k + std::max<int64_t>(50, static_cast<int64_t>(away_s * 1000));
     }
@@ -316,7 +328,8 @@ Figures Soak(const std::filesystem::path& dir) {
   std::string problem;
   {
     // the capture needs the link to start: the controller makes it first
-    std::thread controller([&] { frames = Controller(link, captured_bytes, problem); });
+    std::thread controller(
+        [&] { frames = Controller(link, captured_bytes, problem, figures.stalled_at_frame); });
     while (!std::filesystem::is_symlink(link) && problem.empty()) std::this_thread::sleep_for(1ms);
     std::thread capture([&] {
       summary = RunCapture(options, calibration, stop, [&](const CaptureStatus& status) {
@@ -378,7 +391,7 @@ void BM_CaptureSoak(benchmark::State& state) {
       "  reconnects marked: %lld of %d unplugs (5 shorter than a second, link re-created)\n"
       "  frames missing by the log's gaps: %lld (truth: %lld)\n"
       "  replay rows differing from the live log: %lld\n"
-      "  wall time: %.1f s (%.0f frames/s, unplugged time included)\n",
+      "  wall time: %.1f s (%.0f frames/s, unplugged time included)\n%s",
       static_cast<long long>(figures.sent), static_cast<long long>(figures.sent_in_windows),
       static_cast<long long>(figures.corrupted), static_cast<long long>(figures.kept),
       static_cast<long long>(figures.lost_outside_windows),
@@ -387,7 +400,12 @@ void BM_CaptureSoak(benchmark::State& state) {
       static_cast<long long>(figures.missing_reported),
       static_cast<long long>(figures.missing_expected),
       static_cast<long long>(figures.replay_rows_differing), figures.wall_s,
-      static_cast<double>(figures.sent) / figures.wall_s);
+      static_cast<double>(figures.sent) / figures.wall_s,
+      figures.stalled_at_frame < 0
+          ? ""
+          : ("  the capture stopped reading at frame " + std::to_string(figures.stalled_at_frame) +
+             " (never reconnected): the controller stopped sending\n")
+                .c_str());
 }
 BENCHMARK(BM_CaptureSoak)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 

@@ -97,11 +97,14 @@ bool LinkReplaced(const PortIdentity& before, const PortIdentity& now) {
                          !SameTime(now.changed, before.changed));
 }
 
-// kInvalidArgument when `path` names anything (a dangling symlink included): the capture's
-// `what` ("log", "journal") would replace an earlier recording.
-Status RefuseExistingOutput(const std::filesystem::path& path, std::string_view what) {
+// kInvalidArgument when `path` names anything (a dangling symlink included) and may not be
+// replaced: the capture's `what` ("log", "journal") would replace an earlier recording.
+Status RefuseExistingOutput(const std::filesystem::path& path, std::string_view what,
+                            bool replace_existing) {
   std::error_code error;
-  if (!std::filesystem::exists(std::filesystem::symlink_status(path, error))) return Status::Ok();
+  if (replace_existing || !std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+    return Status::Ok();
+  }
   return InvalidArgumentError(path.string() + ": exists (the " + std::string(what) +
                               " of an earlier recording?); choose another name, or pass "
                               "--force to replace it");
@@ -321,10 +324,14 @@ Status CaptureOptions::Validate() const {
   if (port.empty()) return InvalidArgumentError("capture port: expected a device path or id");
   LIFTOFF_RETURN_IF_ERROR(settings.Validate());
   if (log_path.empty()) return InvalidArgumentError("capture log_path: expected a file to write");
-  std::error_code error;
+  // the same file under two spellings ("a.csv", "./a.csv") is the same file
+  std::error_code journal_error;
+  std::error_code log_error;
+  const std::filesystem::path journal_resolved =
+      std::filesystem::weakly_canonical(JournalPath(), journal_error);
+  const std::filesystem::path log_resolved = std::filesystem::weakly_canonical(log_path, log_error);
   if (JournalPath() == log_path ||
-      std::filesystem::weakly_canonical(JournalPath(), error) ==
-          std::filesystem::weakly_canonical(log_path, error)) {
+      (!journal_error && !log_error && journal_resolved == log_resolved)) {
     return InvalidArgumentError("capture journal_path: must differ from the log path " +
                                 log_path.string());
   }
@@ -394,9 +401,8 @@ class LogSink {
         options_.JournalPath().filename().string(), decoder.device_header(),
         options_.send_start ? std::optional(options_.start_command) : std::nullopt);
     // the log appears once the device is known: it must still be new then
-    if (!options_.replace_existing) {
-      LIFTOFF_RETURN_IF_ERROR(RefuseExistingOutput(options_.log_path, "log"));
-    }
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
     LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options_.log_path));
     LIFTOFF_RETURN_IF_ERROR(writer_.Open(options_.log_path, header));
     for (const LogRow& row : pending_) LIFTOFF_RETURN_IF_ERROR(Write(row));
@@ -435,8 +441,10 @@ class Capture {
   Result<CaptureSummary> Run() {
     started_ns_ = MonotonicNowNs();
     // an earlier recording is never replaced unless asked: checked before anything is touched
-    LIFTOFF_RETURN_IF_ERROR(RefuseExisting(options_.log_path, "log"));
-    LIFTOFF_RETURN_IF_ERROR(RefuseExisting(options_.JournalPath(), "journal"));
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.JournalPath(), "journal", options_.replace_existing));
     // the port first: a wrong name fails before any file is made
     auto port = OpenSerialPort(options_.port, options_.settings);
     if (!port.ok()) return port.status();
@@ -473,11 +481,6 @@ class Capture {
 
  private:
   double ElapsedS() const { return SecondsFromNs(MonotonicNowNs() - started_ns_); }
-
-  // kInvalidArgument when `path` exists (a dangling symlink included) and may not be replaced.
-  Status RefuseExisting(const std::filesystem::path& path, std::string_view what) const {
-    return options_.replace_existing ? Status::Ok() : RefuseExistingOutput(path, what);
-  }
 
   Status Loop() {
     if (options_.send_start) LIFTOFF_RETURN_IF_ERROR(SendStart());
