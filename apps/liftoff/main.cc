@@ -244,6 +244,8 @@ int main(int argc, char** argv) {
       ->required();
   capture_app->add_option("--output,-o", capture.log_path, "Controller log to write")->required();
   capture_app->add_option("--journal", capture.journal_path, "Raw journal (default: LOG.journal)");
+  capture_app->add_flag("--force", capture.force,
+                        "Replace an existing log and journal (an earlier recording)");
   capture_app->add_option("--baud", capture.baud_rate, "Line speed, bits/s")->capture_default_str();
   capture_app->add_flag("--start", capture.send_start,
                         "Send START with the test parameters and record them in the log");

@@ -52,30 +52,69 @@ std::vector<std::string> CompareWithCalibration(const wire::HeaderFrame& header,
 // under its own name (a new one that gets the same number belongs to whoever opened it),
 // so after a loss it is reopened only through a symlink replaced since (an emulator's
 // link re-pointed at its new pty, as udev re-creates /dev/serial/by-id links on replug).
+// A link counts as replaced when its inode, its target or either of its timestamps (to
+// the nanosecond) differs: ext4 hands a link removed and re-created at once the same
+// inode, and within the same second the same seconds-resolution times.
 struct PortIdentity {
   bool pseudo_terminal = false;
+  bool symlink = false;
   dev_t device = 0;
   ino_t inode = 0;
+  std::string target;
+  timespec modified{};
+  timespec changed{};
 };
 
-PortIdentity IdentifyPort(const std::string& port) {
+bool SameTime(const timespec& a, const timespec& b) {
+  return a.tv_sec == b.tv_sec && a.tv_nsec == b.tv_nsec;
+}
+
+// The identity of the name itself (not of what it points at).
+PortIdentity LinkIdentity(const std::string& port) {
   PortIdentity identity;
-  identity.pseudo_terminal = IsPseudoTerminal(port);
   struct stat status {};
-  if (::lstat(port.c_str(), &status) == 0) {
-    identity.device = status.st_dev;
-    identity.inode = status.st_ino;
-  }
+  if (::lstat(port.c_str(), &status) != 0) return identity;
+  identity.symlink = S_ISLNK(status.st_mode);
+  identity.device = status.st_dev;
+  identity.inode = status.st_ino;
+  identity.modified = status.st_mtim;
+  identity.changed = status.st_ctim;
+  std::error_code error;
+  if (identity.symlink) identity.target = std::filesystem::read_symlink(port, error).string();
   return identity;
+}
+
+PortIdentity IdentifyPort(const std::string& port) {
+  PortIdentity identity = LinkIdentity(port);
+  identity.pseudo_terminal = IsPseudoTerminal(port);
+  return identity;
+}
+
+bool LinkReplaced(const PortIdentity& before, const PortIdentity& now) {
+  return now.symlink && (now.inode != before.inode || now.device != before.device ||
+                         now.target != before.target ||
+                         !SameTime(now.modified, before.modified) ||
+                         !SameTime(now.changed, before.changed));
+}
+
+// kInvalidArgument when `path` names anything (a dangling symlink included) and may not be
+// replaced: the capture's `what` ("log", "journal") would replace an earlier recording.
+Status RefuseExistingOutput(const std::filesystem::path& path, std::string_view what,
+                            bool replace_existing) {
+  std::error_code error;
+  if (replace_existing || !std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+    return Status::Ok();
+  }
+  return InvalidArgumentError(path.string() + ": exists (the " + std::string(what) +
+                              " of an earlier recording?); choose another name, or pass "
+                              "--force to replace it");
 }
 
 bool MayReopen(const std::string& port, const PortIdentity& before) {
   std::error_code error;
   if (!std::filesystem::exists(port, error)) return IsStableId(port);
   if (!before.pseudo_terminal) return true;
-  struct stat status {};
-  return ::lstat(port.c_str(), &status) == 0 && S_ISLNK(status.st_mode) &&
-         (status.st_ino != before.inode || status.st_dev != before.device);
+  return LinkReplaced(before, LinkIdentity(port));
 }
 
 }  // namespace
@@ -104,15 +143,27 @@ void StreamDecoder::LinkRestored(int64_t host_time_ns) {
   link_lost_host_ns_.reset();
 }
 
+// Rows come out in the log's order (docs/formats.md): by device time, and at one instant
+// the events before the sample. A sample is therefore held back until a row of a later
+// instant arrives (samples are strictly increasing, so at most one waits).
 void StreamDecoder::Emit(LogRow row, std::vector<LogRow>& rows) {
-  last_row_ns_ = RowTimeNs(row);
-  if (const auto* sample = std::get_if<LogSample>(&row)) {
+  const int64_t row_ns = RowTimeNs(row);
+  last_row_ns_ = row_ns;
+  if (held_sample_ && held_sample_->device_time_ns < row_ns) Finish(rows);
+  if (auto* sample = std::get_if<LogSample>(&row)) {
     ++counters_.samples;
-    last_sample_ns_ = sample->device_time_ns;
-  } else {
-    ++counters_.events;
+    last_sample_ns_ = row_ns;
+    held_sample_ = std::move(*sample);
+    return;
   }
+  ++counters_.events;
   rows.push_back(std::move(row));
+}
+
+void StreamDecoder::Finish(std::vector<LogRow>& rows) {
+  if (!held_sample_) return;
+  rows.emplace_back(std::move(*held_sample_));
+  held_sample_.reset();
 }
 
 bool StreamDecoder::IsRestart(uint32_t sequence, uint32_t device_time_us) const {
@@ -273,7 +324,14 @@ Status CaptureOptions::Validate() const {
   if (port.empty()) return InvalidArgumentError("capture port: expected a device path or id");
   LIFTOFF_RETURN_IF_ERROR(settings.Validate());
   if (log_path.empty()) return InvalidArgumentError("capture log_path: expected a file to write");
-  if (JournalPath() == log_path) {
+  // the same file under two spellings ("a.csv", "./a.csv") is the same file
+  std::error_code journal_error;
+  std::error_code log_error;
+  const std::filesystem::path journal_resolved =
+      std::filesystem::weakly_canonical(JournalPath(), journal_error);
+  const std::filesystem::path log_resolved = std::filesystem::weakly_canonical(log_path, log_error);
+  if (JournalPath() == log_path ||
+      (!journal_error && !log_error && journal_resolved == log_resolved)) {
     return InvalidArgumentError("capture journal_path: must differ from the log path " +
                                 log_path.string());
   }
@@ -342,6 +400,9 @@ class LogSink {
         calibration_, "capture " + options_.port, SettingsText(options_.settings),
         options_.JournalPath().filename().string(), decoder.device_header(),
         options_.send_start ? std::optional(options_.start_command) : std::nullopt);
+    // the log appears once the device is known: it must still be new then
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
     LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options_.log_path));
     LIFTOFF_RETURN_IF_ERROR(writer_.Open(options_.log_path, header));
     for (const LogRow& row : pending_) LIFTOFF_RETURN_IF_ERROR(Write(row));
@@ -379,6 +440,11 @@ class Capture {
 
   Result<CaptureSummary> Run() {
     started_ns_ = MonotonicNowNs();
+    // an earlier recording is never replaced unless asked: checked before anything is touched
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
+    LIFTOFF_RETURN_IF_ERROR(
+        RefuseExistingOutput(options_.JournalPath(), "journal", options_.replace_existing));
     // the port first: a wrong name fails before any file is made
     auto port = OpenSerialPort(options_.port, options_.settings);
     if (!port.ok()) return port.status();
@@ -389,11 +455,17 @@ class Capture {
     header.port = options_.port;
     header.settings = SettingsText(options_.settings);
     header.start_time_ns = HostNowNs();
-    LIFTOFF_RETURN_IF_ERROR(journal_.Open(options_.JournalPath(), header));
+    JournalWriter::Options journal_options;
+    journal_options.replace_existing = options_.replace_existing;
+    LIFTOFF_RETURN_IF_ERROR(journal_.Open(options_.JournalPath(), header, journal_options));
 
     const Status looped = Loop();
     // whatever happened, everything received reaches the disk
     Status finished = looped;
+    std::vector<LogRow> last_rows;
+    decoder_.Finish(last_rows);
+    const Status added = log_.Add(last_rows);
+    if (finished.ok()) finished = added;
     if (!log_.is_open()) {
       const Status opened = log_.Open(decoder_);
       if (finished.ok()) finished = opened;

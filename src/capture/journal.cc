@@ -156,7 +156,11 @@ Status JournalWriter::Open(const std::filesystem::path& path, const JournalHeade
   path_ = path;
   options_ = options;
   bytes_received_ = 0;
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int replace = options.replace_existing ? O_TRUNC : O_EXCL;
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | replace, 0644);
+  if (fd_ < 0 && errno == EEXIST && !options.replace_existing) {
+    return InvalidArgumentError(path.string() + ": exists; expected a new journal");
+  }
   if (fd_ < 0) return IoError(path.string() + ": cannot open for writing: " + Errno());
 
   // the header reaches the disk at once: the journal names its port even if nothing came
@@ -371,6 +375,7 @@ Result<JournalReplay> ReplayJournal(const std::filesystem::path& path,
     }
   }
   LIFTOFF_RETURN_IF_ERROR(reader.status());
+  decoder.Finish(rows);
 
   // the log
   ControllerLog& log = replay.log;

@@ -108,6 +108,7 @@ int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& e
   options.settings.baud_rate = command.baud_rate;
   options.log_path = command.log_path;
   options.journal_path = command.journal_path;
+  options.replace_existing = command.force;
   options.max_duration_s = command.max_duration_s;
   options.first_frame_timeout_s = command.first_frame_timeout_s;
   options.stop_on_test_end = !command.no_stop_on_test_end;

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -841,6 +842,201 @@ TEST(CaptureSession, SilentPortTimesOutWithItsJournalOnDisk) {
   JournalChunk chunk;
   ASSERT_TRUE(reader.Next(chunk));
   EXPECT_EQ(chunk.bytes, noise);
+}
+
+
+// ---------------------------------------------------------------------------------------
+// issue 12: earlier recordings, replaced links, replay order
+
+// Writes `frames` to a pty's master as the controller would.
+void SendFrames(int master_fd, const std::vector<wire::Frame>& frames) {
+  std::string bytes;
+  for (const wire::Frame& frame : frames) {
+    char line[wire::kMaxFrameBytes];
+    size_t size = 0;
+    switch (frame.type) {
+      case wire::FrameType::kSample: size = wire::EncodeSample(frame.sample, line, sizeof line); break;
+      case wire::FrameType::kHeader: size = wire::EncodeHeader(frame.header, line, sizeof line); break;
+      case wire::FrameType::kEvent: size = wire::EncodeEvent(frame.event, line, sizeof line); break;
+      case wire::FrameType::kCommand: break;
+    }
+    ASSERT_GT(size, 0u);
+    bytes.append(line, size);
+  }
+  ASSERT_EQ(::write(master_fd, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+}
+
+wire::Frame Sample(uint32_t sequence, uint32_t device_time_us) {
+  wire::Frame frame;
+  frame.type = wire::FrameType::kSample;
+  frame.sample.sequence = sequence;
+  frame.sample.device_time_us = device_time_us;
+  frame.sample.led_on = 1;
+  frame.sample.rotate_counts = static_cast<int32_t>(sequence) * 3;
+  return frame;
+}
+
+wire::Frame Event(uint32_t sequence, uint32_t device_time_us, wire::EventKind kind) {
+  wire::Frame frame;
+  frame.type = wire::FrameType::kEvent;
+  frame.event.sequence = sequence;
+  frame.event.device_time_us = device_time_us;
+  frame.event.kind = kind;
+  return frame;
+}
+
+wire::Frame Header(uint32_t sequence, uint32_t device_time_us) {
+  wire::Frame frame;
+  frame.type = wire::FrameType::kHeader;
+  frame.header.sequence = sequence;
+  frame.header.device_time_us = device_time_us;
+  frame.header.protocol_version = 1;
+  std::strcpy(frame.header.firmware, "hand 1.0");
+  frame.header.counts_per_motor_rev = 12;
+  frame.header.gearbox_ratio = 1000;
+  frame.header.spur_gear_ratio = 4;
+  return frame;
+}
+
+TEST(CaptureSession, RefusesToReplaceAnEarlierRecordingUnlessForced) {
+  ScratchDir dir;
+  auto pty = PseudoTerminal::Open();
+  ASSERT_TRUE(pty.ok());
+  std::atomic<bool> stop{false};
+  CaptureOptions options = QuickCapture(pty->slave_path(), dir / "trial.csv");
+  options.max_duration_s = 0.1;
+
+  // an earlier log, or only its journal, or a dangling link where the log goes: refused,
+  // naming the file, and nothing changes
+  WriteFile(dir / "trial.csv", "earlier trial\n");
+  auto result = RunCapture(options, DriveChainCalibration(), stop);
+  EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(result.status().message(), HasSubstr((dir / "trial.csv").string() + ": exists"));
+  EXPECT_THAT(result.status().message(), HasSubstr("--force"));
+  EXPECT_EQ(ReadFile(dir / "trial.csv"), "earlier trial\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "trial.csv.journal"));
+
+  std::filesystem::rename(dir / "trial.csv", dir / "trial.csv.journal");
+  result = RunCapture(options, DriveChainCalibration(), stop);
+  EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(result.status().message(), HasSubstr("trial.csv.journal: exists"));
+  EXPECT_EQ(ReadFile(dir / "trial.csv.journal"), "earlier trial\n");
+  EXPECT_FALSE(std::filesystem::exists(dir / "trial.csv"));
+
+  std::filesystem::create_symlink(dir / "nowhere.csv", dir / "other.csv");
+  options.log_path = dir / "other.csv";
+  result = RunCapture(options, DriveChainCalibration(), stop);
+  EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "nowhere.csv"));
+
+  // a journal named as the log through another spelling is the log
+  options.log_path = dir / "new.csv";
+  options.journal_path = dir / "." / "new.csv";
+  result = RunCapture(options, DriveChainCalibration(), stop);
+  EXPECT_THAT(result.status().message(), HasSubstr("capture journal_path: must differ"));
+
+  // with replace_existing (--force) the earlier journal is replaced
+  options.log_path = dir / "trial.csv";
+  options.journal_path.clear();
+  options.replace_existing = true;
+  result = RunCapture(options, DriveChainCalibration(), stop);
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  JournalReader reader;
+  EXPECT_TRUE(reader.Open(dir / "trial.csv.journal").ok());
+  EXPECT_TRUE(std::filesystem::exists(dir / "trial.csv"));
+}
+
+TEST(CaptureCommands, CaptureRefusesAnExistingLogAndForceReplacesIt) {
+  ScratchDir dir;
+  auto pty = PseudoTerminal::Open();
+  ASSERT_TRUE(pty.ok());
+  const std::string log_path = (dir / "trial.csv").string();
+  WriteFile(log_path, "earlier trial\n");
+  BinaryRun run = RunBinary({"capture", pty->slave_path(), "-o", log_path, "--max-duration", "0.1",
+                             "--first-frame-timeout", "0", "--status", "off"},
+                            dir);
+  EXPECT_EQ(run.code, 3) << run.err;
+  EXPECT_THAT(run.err, HasSubstr(log_path + ": exists"));
+  EXPECT_EQ(ReadFile(log_path), "earlier trial\n");
+  run = RunBinary({"capture", pty->slave_path(), "-o", log_path, "--max-duration", "0.1",
+                   "--first-frame-timeout", "0", "--status", "off", "--force"},
+                  dir);
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_THAT(ReadFile(log_path), HasSubstr("# liftoff-log 1"));
+}
+
+// A pty link removed and re-created at once gets its inode back on ext4 (and the same
+// seconds-resolution times): the capture must still see a new link and reopen it.
+TEST(CaptureSession, ReopensALinkRemovedAndRecreatedAtOnce) {
+  ScratchDir dir;
+  auto first = PseudoTerminal::Open();
+  ASSERT_TRUE(first.ok());
+  const std::filesystem::path link = dir / "controller";
+  std::filesystem::create_symlink(first->slave_path(), link);
+  CaptureOptions options = QuickCapture(link.string(), dir / "trial.csv");
+  options.stop_on_test_end = false;
+  CaptureThread capture(options, DriveChainCalibration());
+  SendFrames(first->master_fd(), {Header(0, 0), Sample(1, 1000), Sample(2, 2000)});
+  ASSERT_TRUE(WaitFor([&] { return capture.frames() >= 3; }, 5));
+
+  // unplug: the old pty goes, a new one comes under the same link within the same second
+  auto second = PseudoTerminal::Open();
+  ASSERT_TRUE(second.ok());
+  std::filesystem::remove(link);
+  first->CloseMaster();
+  std::filesystem::create_symlink(second->slave_path(), link);
+  SendFrames(second->master_fd(), {Sample(3, 3000), Sample(4, 4000)});
+  const bool reopened = WaitFor([&] { return capture.frames() >= 5; }, 3);
+  auto summary = capture.Finish(true);
+  ASSERT_TRUE(summary.ok()) << summary.status().ToString();
+  EXPECT_TRUE(reopened) << summary->Brief();
+  EXPECT_EQ(summary->reconnects, 1);
+  EXPECT_EQ(summary->samples, 4);
+}
+
+// The controller sends a sample and events at one device instant in both orders; the
+// live log and the log rebuilt from its journal must be the same rows, byte for byte, in
+// the documented order (docs/formats.md: the events of an instant before its sample).
+TEST(CaptureSession, LiveLogAndItsReplayAreTheSameBytes) {
+  ScratchDir dir;
+  auto pty = PseudoTerminal::Open();
+  ASSERT_TRUE(pty.ok());
+  CaptureOptions options = QuickCapture(pty->slave_path(), dir / "trial.csv");
+  CaptureThread capture(options, DriveChainCalibration());
+  SendFrames(pty->master_fd(),
+             {Header(0, 0), Sample(1, 1000), Event(2, 1000, wire::EventKind::kAck),
+              Event(3, 1000, wire::EventKind::kTestStart), Event(4, 1000, wire::EventKind::kLedOn),
+              Sample(5, 2000), Event(6, 3000, wire::EventKind::kLedOff), Sample(7, 3000),
+              Sample(9, 4000), Event(10, 4000, wire::EventKind::kTestEnd)});
+  auto summary = capture.Finish(false);  // stops at TEST_END
+  ASSERT_TRUE(summary.ok()) << summary.status().ToString();
+  EXPECT_EQ(summary->stopped_by, "test end");
+
+  auto replay = ReplayJournal(dir / "trial.csv.journal", DriveChainCalibration());
+  ASSERT_TRUE(replay.ok()) << replay.status().ToString();
+  ASSERT_TRUE(WriteControllerLog(dir / "replay.csv", replay->log).ok());
+  const auto rows = [](const std::string& text) {
+    return text.substr(text.find("device_time_ns,"));
+  };
+  const std::string live = ReadFile(dir / "trial.csv");
+  ASSERT_NE(live.find("device_time_ns,"), std::string::npos) << live;
+  EXPECT_EQ(rows(live), rows(ReadFile(dir / "replay.csv")));
+
+  // the order, by hand: device time in us and event name ("" for a sample) of each row
+  std::vector<std::string> order;
+  std::istringstream lines(rows(live));
+  std::string line;
+  std::getline(lines, line);  // column names
+  while (std::getline(lines, line)) {
+    std::vector<std::string> fields;
+    std::istringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
+    ASSERT_GE(fields.size(), 10u) << line;
+    order.push_back(fields[0].substr(0, fields[0].size() - 3) + " " + fields[9]);
+  }
+  EXPECT_THAT(order, ::testing::ElementsAre("1000 note", "1000 test_start", "1000 led_on", "1000 ",
+                                            "2000 ", "3000 led_off", "3000 ", "3500 gap",
+                                            "4000 test_end", "4000 "));
 }
 
 }  // namespace

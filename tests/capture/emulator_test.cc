@@ -330,6 +330,39 @@ TEST(ControllerModel, PingIsAnsweredWithItsToken) {
   EXPECT_EQ(frames[1].type, FrameType::kHeader);
 }
 
+// docs/protocol.md section 3: a header follows every reply, during a test too, and no
+// other header interrupts a running test.
+TEST(ControllerModel, EveryReplyIsFollowedByAHeaderEvenDuringATest) {
+  const ControllerModelOptions options = ShortTest();
+  ControllerModel model(options);
+  Take(model);
+  model.Command(MakeCommand(wire::CommandKind::kStart), 100 * kMs);
+  std::vector<wire::Frame> frames = Take(model);
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(frames.back().type, FrameType::kHeader);
+  // 1.2 s of samples into the test: no header of its own
+  for (int64_t t_ms = 110; t_ms <= 1300; t_ms += 10) {
+    model.Advance(t_ms * kMs);
+    model.EmitSample();
+  }
+  for (const wire::Frame& frame : Take(model)) EXPECT_NE(frame.type, FrameType::kHeader);
+  ASSERT_EQ(model.phase(), TestPhase::kRamping);
+  // a PING during the test: PONG, then a header
+  model.Command(MakeCommand(wire::CommandKind::kPing, -7), 1305 * kMs);
+  frames = Take(model);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].event.kind, EventKind::kPong);
+  EXPECT_EQ(frames[0].event.arg, -7);  // arg is signed: the token comes back as sent
+  EXPECT_EQ(frames[1].type, FrameType::kHeader);
+  EXPECT_EQ(frames[1].header.device_time_us, 1'305'000u);
+  // a START refused as busy: NAK, then a header
+  model.Command(MakeCommand(wire::CommandKind::kStart), 1310 * kMs);
+  frames = Take(model);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].event.kind, EventKind::kNak);
+  EXPECT_EQ(frames[1].type, FrameType::kHeader);
+}
+
 TEST(ControllerModel, BadCommandsAreRefusedWithNak) {
   struct Case {
     wire::CommandFrame command;

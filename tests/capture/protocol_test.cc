@@ -186,6 +186,18 @@ TEST(FrameParser, CountsEveryByteAndEveryKindOfBadLine) {
       << parser.stats().Brief();
 }
 
+// docs/protocol.md section 2: the CRC is upper-case hex; a line whose CRC is right but
+// written in lower case is malformed, never accepted.
+TEST(FrameParser, RejectsALowerCaseChecksumAsMalformed) {
+  FrameParser parser;
+  const std::string line = "$S,1,2,1,3,4,5,6*c945\n";
+  EXPECT_TRUE(FeedAll(parser, line + "$S,1,2,1,3,4,5,6*C945\n").size() == 1);
+  EXPECT_EQ(parser.stats().malformed_frames, 1);
+  EXPECT_EQ(parser.stats().checksum_errors, 0);
+  EXPECT_EQ(parser.stats().rejected_bytes, static_cast<int64_t>(line.size()));
+  ExpectStatsAddUp(parser);
+}
+
 TEST(FrameParser, DropsOverLongLinesAndResynchronises) {
   FrameParser parser;
   const std::string good = SampleText(5);

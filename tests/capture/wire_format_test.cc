@@ -318,6 +318,20 @@ TEST(WireFormat, ReportsEveryDecodeError) {
   }
 }
 
+// docs/protocol.md section 3: an event's arg is a signed 32-bit integer.
+TEST(WireFormat, EventArgIsASignedThirtyTwoBitInteger) {
+  Frame frame;
+  ASSERT_EQ(Decode(WithCrc("E,5,6,PONG,-42,"), &frame), DecodeError::kOk);
+  EXPECT_EQ(frame.event.arg, -42);
+  ASSERT_EQ(Decode(WithCrc("E,5,6,PONG,-2147483648,"), &frame), DecodeError::kOk);
+  EXPECT_EQ(frame.event.arg, INT32_MIN);
+  ASSERT_EQ(Decode(WithCrc("E,5,6,PONG,2147483647,"), &frame), DecodeError::kOk);
+  EXPECT_EQ(frame.event.arg, INT32_MAX);
+  EXPECT_EQ(Decode(WithCrc("E,5,6,PONG,2147483648,"), &frame), DecodeError::kBadField);
+  EXPECT_EQ(Decode(WithCrc("E,5,6,PONG,-2147483649,"), &frame), DecodeError::kBadField);
+  EXPECT_EQ(Decode(WithCrc("E,5,6,PONG,+1,"), &frame), DecodeError::kBadField);
+}
+
 TEST(WireFormat, RejectsTextWithFrameCharactersEvenWithAValidChecksum) {
   // found by the fuzzer: the decoder took characters the encoder refuses, so a decoded
   // frame could not be sent again

@@ -64,8 +64,13 @@ class StreamDecoder {
   /// `calibration` converts counts into angles; it must outlive the decoder.
   explicit StreamDecoder(const Calibration& calibration);
 
-  /// Parses `bytes` received at `host_time_ns` and appends the resulting rows to `rows`.
+  /// Parses `bytes` received at `host_time_ns` and appends the resulting rows to `rows`,
+  /// in the log's order (docs/formats.md): by device time, and the events of an instant
+  /// before its sample, whatever order they arrived in. The last sample is therefore held
+  /// back until a row of a later instant arrives, or Finish.
   void Feed(std::span<const uint8_t> bytes, int64_t host_time_ns, std::vector<LogRow>& rows);
+  /// The end of the stream: appends the sample held back, if any.
+  void Finish(std::vector<LogRow>& rows);
   /// The link went away at `host_time_ns`: a frame cut in half is dropped.
   void LinkLost(int64_t host_time_ns);
   /// The link is back at `host_time_ns`: the next frame is preceded by a reconnect event
@@ -107,6 +112,7 @@ class StreamDecoder {
   bool test_ended_ = false;
   std::optional<bool> led_on_;
   double last_vertebra_rad_ = kNotMeasured;
+  std::optional<LogSample> held_sample_;  // the last sample, until its instant is over
 };
 
 /// Header metadata of a capture's log: the device's header frame as device_* keys and
@@ -160,11 +166,15 @@ struct CaptureOptions {
   double header_wait_s = 1.5;
   /// Journal and log lines reach the operating system at least this often, ms (> 0).
   double flush_interval_ms = 100.0;
+  /// Replace an existing log or journal (an earlier recording). Off: RunCapture refuses
+  /// with kInvalidArgument before it touches the port or any file.
+  bool replace_existing = false;
 
   /// The journal path in use: journal_path, or log_path + ".journal".
   std::filesystem::path JournalPath() const;
-  /// kInvalidArgument naming the field: empty port or log path, non-positive intervals,
-  /// negative durations, a start command that is not START.
+  /// kInvalidArgument naming the field: empty port or log path, a journal that is the log
+  /// (compared as resolved paths), non-positive intervals, negative durations, a start
+  /// command that is not START.
   Status Validate() const;
 };
 
@@ -226,7 +236,8 @@ struct CaptureStatus {
 
 /// Runs a capture until `stop` is set, the test ends (stop_on_test_end), or
 /// max_duration_s passes; calls `on_status` (when set) every status_interval_s from the
-/// calling thread. Errors: kInvalidArgument for bad options; the port's errors when it
+/// calling thread. Errors: kInvalidArgument for bad options, and for a log or journal that
+/// exists already unless replace_existing (nothing is touched then); the port's errors when it
 /// cannot be opened at the start (kNotFound, kIo); kIo when the journal or log cannot be
 /// written; kTimeout when first_frame_timeout_s passes without a frame. The journal and
 /// the log are flushed and closed on every path.

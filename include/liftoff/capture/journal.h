@@ -72,6 +72,9 @@ class JournalWriter {
     /// buffered, bytes. Flushing on a timer is the owner's job (call Flush(): a capture
     /// does so every flush_interval_ms), so a crash of the process loses nothing older.
     size_t flush_bytes = 64 * 1024;
+    /// Replace an existing file. Off: Open fails with kInvalidArgument when the path
+    /// exists (checked by the creation itself, O_EXCL, so two writers cannot both win).
+    bool replace_existing = true;
 
     Status Validate() const;
   };
@@ -82,7 +85,8 @@ class JournalWriter {
   ~JournalWriter();  ///< closes (flushes) when still open
 
   /// Creates (truncates) `path`, creating its folder, and writes the header at once.
-  /// kIo naming the file on failure, kInvalidArgument for bad options.
+  /// kIo naming the file on failure, kInvalidArgument for bad options and for an
+  /// existing file when not options.replace_existing.
   Status Open(const std::filesystem::path& path, const JournalHeader& header,
               const Options& options);
   Status Open(const std::filesystem::path& path, const JournalHeader& header) {

@@ -34,6 +34,8 @@ struct CaptureCommand {
   std::filesystem::path log_path;
   /// Raw journal; empty: LOG.journal.
   std::filesystem::path journal_path;
+  /// Replace an existing log or journal; off: refuse (exit code of kInvalidArgument).
+  bool force = false;
   /// Line speed, bits/s.
   int baud_rate = 115200;
   /// Send START with `test` once the port is open.
