@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "liftoff/capture/journal.h"
+#include "liftoff/core/output.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/robot.h"
 #include "liftoff/core/text.h"
@@ -99,17 +100,6 @@ bool LinkReplaced(const PortIdentity& before, const PortIdentity& now) {
 
 // kInvalidArgument when `path` names anything (a dangling symlink included) and may not be
 // replaced: the capture's `what` ("log", "journal") would replace an earlier recording.
-Status RefuseExistingOutput(const std::filesystem::path& path, std::string_view what,
-                            bool replace_existing) {
-  std::error_code error;
-  if (replace_existing || !std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
-    return Status::Ok();
-  }
-  return InvalidArgumentError(path.string() + ": exists (the " + std::string(what) +
-                              " of an earlier recording?); choose another name, or pass "
-                              "--force to replace it");
-}
-
 bool MayReopen(const std::string& port, const PortIdentity& before) {
   std::error_code error;
   if (!std::filesystem::exists(port, error)) return IsStableId(port);
@@ -402,7 +392,8 @@ class LogSink {
         options_.send_start ? std::optional(options_.start_command) : std::nullopt);
     // the log appears once the device is known: it must still be new then
     LIFTOFF_RETURN_IF_ERROR(
-        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
+        RefuseToReplace(options_.log_path, "the log of an earlier recording?",
+                        options_.replace_existing));
     LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options_.log_path));
     LIFTOFF_RETURN_IF_ERROR(writer_.Open(options_.log_path, header));
     for (const LogRow& row : pending_) LIFTOFF_RETURN_IF_ERROR(Write(row));
@@ -442,9 +433,11 @@ class Capture {
     started_ns_ = MonotonicNowNs();
     // an earlier recording is never replaced unless asked: checked before anything is touched
     LIFTOFF_RETURN_IF_ERROR(
-        RefuseExistingOutput(options_.log_path, "log", options_.replace_existing));
+        RefuseToReplace(options_.log_path, "the log of an earlier recording?",
+                        options_.replace_existing));
     LIFTOFF_RETURN_IF_ERROR(
-        RefuseExistingOutput(options_.JournalPath(), "journal", options_.replace_existing));
+        RefuseToReplace(options_.JournalPath(), "the journal of an earlier recording?",
+                        options_.replace_existing));
     // the port first: a wrong name fails before any file is made
     auto port = OpenSerialPort(options_.port, options_.settings);
     if (!port.ok()) return port.status();

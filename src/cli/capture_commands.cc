@@ -15,6 +15,7 @@
 #include "liftoff/capture/emulator.h"
 #include "liftoff/capture/journal.h"
 #include "liftoff/capture/serial_port.h"
+#include "liftoff/core/output.h"
 #include "liftoff/core/robot.h"
 #include "liftoff/core/text.h"
 
@@ -229,11 +230,9 @@ int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& e
   }
 
   // replay: the log as live capture would have written it
-  if (!command.output_path.empty() && !command.force &&
-      std::filesystem::exists(command.output_path)) {
-    return ReportError(
-        InvalidArgumentError(command.output_path.string() + ": exists; --force overwrites it"),
-        err);
+  if (!command.output_path.empty()) {
+    const Status refused = RefuseToReplace(command.output_path, "", command.force);
+    if (!refused.ok()) return ReportError(refused, err);
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);

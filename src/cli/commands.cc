@@ -10,6 +10,7 @@
 #include "cli_common.h"
 #include "liftoff/capture/laika2018.h"
 #include "liftoff/cli/video_commands.h"
+#include "liftoff/core/output.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
@@ -205,11 +206,9 @@ int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostr
       refused != kExitOk) {
     return refused;
   }
-  std::error_code error;
-  if (std::filesystem::exists(command.output_path, error) && !command.force) {
-    return ReportError(InvalidArgumentError(command.output_path.string() +
-                                            ": exists; pass --force to overwrite it"),
-                       err);
+  if (const Status refused = RefuseToReplace(command.output_path, "", command.force);
+      !refused.ok()) {
+    return ReportError(refused, err);
   }
   for (const std::string& warning : imported->warnings) err << "warning: " << warning << '\n';
   const Status written = WriteManifest(command.output_path, imported->manifest);

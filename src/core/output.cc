@@ -120,6 +120,15 @@ bool IsFileName(const fs::path& path) { return !path.empty() && path != "-"; }
 // ---------------------------------------------------------------------------------------
 // outputs against inputs
 
+Status RefuseToReplace(const std::filesystem::path& path, std::string_view what, bool replace) {
+  std::error_code error;
+  if (replace || !std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+    return Status::Ok();
+  }
+  const std::string said = what.empty() ? "" : " (" + std::string(what) + ")";
+  return InvalidArgumentError(path.string() + ": exists" + said + "; pass --force to replace it");
+}
+
 bool SameFile(const fs::path& a, const fs::path& b) {
   std::error_code error;
   if (fs::exists(a, error) && fs::exists(b, error)) {

@@ -787,7 +787,7 @@ TEST(CaptureCommands, JournalReplayWritesTheLogAndDumpShowsFrames) {
   run = RunBinary(
       {"journal", (dir / "a.journal").string(), "--replay", "-o", (dir / "a.csv").string()}, dir);
   EXPECT_EQ(run.code, 3);
-  EXPECT_THAT(run.err, HasSubstr("a.csv: exists; --force overwrites it"));
+  EXPECT_THAT(run.err, HasSubstr("a.csv: exists; pass --force to replace it"));
 }
 
 // ---------------------------------------------------------------------------------------

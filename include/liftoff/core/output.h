@@ -28,6 +28,11 @@ bool SameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 Status CheckOutputsAreNotInputs(const std::vector<NamedPath>& outputs,
                                 const std::vector<NamedPath>& inputs);
 
+/// kInvalidArgument when `path` exists (a symbolic link, even dangling, counts) and
+/// `replace` is false: "a.csv: exists (WHAT); pass --force to replace it". `what` says what
+/// the file may be ("the log of an earlier recording?"); empty: nothing is said.
+Status RefuseToReplace(const std::filesystem::path& path, std::string_view what, bool replace);
+
 /// A temporary file beside `target`, "<target>.tmp.<pid>.<random>", created exclusively
 /// (O_EXCL) so two writers of one output never share it. It is removed when the object is
 /// destroyed uncommitted, and on SIGINT, SIGTERM or SIGHUP (then the signal's default
