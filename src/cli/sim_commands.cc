@@ -148,9 +148,7 @@ Status RenameFields(const Status& status) {
 }
 
 Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice) {
-  const std::filesystem::path path =
-      choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
-  return sim::LoadModelDescription(path);
+  return sim::LoadModelDescription(ModelPathFrom(choice));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -376,6 +374,10 @@ void PrintSweep(const sim::SweepResult& sweep, std::ostream& out) {
 
 // ---------------------------------------------------------------------------------------
 // options from flags
+
+std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice) {
+  return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
+}
 
 Result<sim::ExperimentOptions> ExperimentOptionsFrom(const SimExperimentChoice& choice) {
   sim::ExperimentOptions options;
@@ -644,25 +646,23 @@ stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string
   return results;
 }
 
-int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
-  // flags
+Result<sim::SweepOptions> SweepOptionsFrom(const SimSweepCommand& command) {
   auto base = ExperimentOptionsFrom(command.experiment);
-  if (!base.ok()) return ReportError(base.status(), err);
+  if (!base.ok()) return base.status();
   sim::SweepOptions options;
   options.base = *base;
   options.threads = command.threads;
   options.stop_once_decided = !command.full_ramp;
   if (command.threads < 0) {
-    return ReportError(InvalidArgumentError("--threads: expected an integer >= 0, got " +
-                                            std::to_string(command.threads)),
-                       err);
+    return InvalidArgumentError("--threads: expected an integer >= 0, got " +
+                                            std::to_string(command.threads));
   }
   options.feet.clear();
   for (const std::string& name : SplitCommas(command.feet)) {
     auto foot = FootFlag("--feet", name);
-    if (!foot.ok()) return ReportError(foot.status(), err);
+    if (!foot.ok()) return foot.status();
     if (std::find(options.feet.begin(), options.feet.end(), *foot) != options.feet.end()) {
-      return ReportError(InvalidArgumentError("--feet: foot " + name + " appears twice"), err);
+      return InvalidArgumentError("--feet: foot " + name + " appears twice");
     }
     options.feet.push_back(*foot);
   }
@@ -671,42 +671,49 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
     for (const std::string& name : SplitCommas(command.tensions)) {
       auto point = sim::PaperTensionPointByName(name);
       if (!point.ok()) {
-        return ReportError(InvalidArgumentError("--tensions: expected all or a comma-separated "
+        return InvalidArgumentError("--tensions: expected all or a comma-separated "
                                                 "list of low, med-low, mean, med-high, high "
                                                 "(or 0..4), got \"" +
-                                                name + "\""),
-                           err);
+                                                name + "\"");
       }
       for (const TensionPoint& seen : options.tension_points) {
         if (seen.name == point->name) {
-          return ReportError(InvalidArgumentError("--tensions: " + point->name + " appears twice"),
-                             err);
+          return InvalidArgumentError("--tensions: " + point->name + " appears twice");
         }
       }
       options.tension_points.push_back(*point);
     }
   }
+  return options;
+}
+
+Result<sim::SweepResult> RunSweepShowingProgress(const SimSweepCommand& command,
+                                                 std::ostream& err) {
+  LIFTOFF_ASSIGN_OR_RETURN(sim::SweepOptions options, SweepOptionsFrom(command));
+  LIFTOFF_ASSIGN_OR_RETURN(SimProgress progress,
+                           SimProgress::Create(command.experiment.progress, err));
+  LIFTOFF_ASSIGN_OR_RETURN(sim::ModelDescription description, LoadDescription(command.experiment));
+  const int64_t started_ns = MonotonicNowNs();
+  auto sweep = sim::RunSweep(description, options, [&](const sim::SweepProgress& report) {
+    progress.ShowSweep(report);
+  });
+  progress.Done();
+  if (!sweep.ok()) return sweep.status();
+  const double wall_s = SecondsFromNs(MonotonicNowNs() - started_ns);
+  err << "sim: " << Plural(static_cast<int64_t>(sweep->runs.size()), "run") << " in "
+      << FormatFixed(wall_s, 2) << " s wall on " << Plural(sweep->threads, "thread") << '\n';
+  return sweep;
+}
+
+int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
   const auto table_format = stats::ParseTableFormat(command.format);
   if (!table_format) {
     return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
                                             command.format + "\""),
                        err);
   }
-  auto progress = SimProgress::Create(command.experiment.progress, err);
-  if (!progress.ok()) return ReportError(progress.status(), err);
-  auto description = LoadDescription(command.experiment);
-  if (!description.ok()) return ReportError(description.status(), err);
-
-  // the sweep
-  const int64_t started_ns = MonotonicNowNs();
-  auto sweep = sim::RunSweep(*description, options, [&](const sim::SweepProgress& report) {
-    progress->ShowSweep(report);
-  });
-  progress->Done();
+  auto sweep = RunSweepShowingProgress(command, err);
   if (!sweep.ok()) return ReportError(sweep.status(), err);
-  const double wall_s = SecondsFromNs(MonotonicNowNs() - started_ns);
-  err << "sim: " << Plural(static_cast<int64_t>(sweep->runs.size()), "run") << " in "
-      << FormatFixed(wall_s, 2) << " s wall on " << Plural(sweep->threads, "thread") << '\n';
 
   // the results file, then what to print
   const std::string overrides = DescribeOverrides(command.experiment);
