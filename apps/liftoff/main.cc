@@ -9,6 +9,7 @@
 
 #include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/report_command.h"
 #include "liftoff/cli/sim_commands.h"
 #include "liftoff/cli/synth_commands.h"
 #include "liftoff/cli/video_commands.h"
@@ -171,6 +172,34 @@ int main(int argc, char** argv) {
       ->add_option("--progress", table.progress,
                    "Video analysis progress on stderr: auto, live, lines or off")
       ->capture_default_str();
+
+  ReportCommand report;
+  CLI::App* report_app = app.add_subcommand(
+      "report",
+      "The campaign in one folder: every trial, the simulated column (cached), the tables, the "
+      "figures (gnuplot), report.md and report.html");
+  report_app
+      ->add_option("manifest", report.manifest_path,
+                   "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
+      ->required();
+  report_app->add_option("--output,-o", report.output_dir, "Folder to write the report in")
+      ->required();
+  AddCalibrationFlag(report_app, report.calibration);
+  AddLookupFlags(report_app, report.lookup);
+  report_app->add_flag("--no-sim", report.no_sim, "Leave the simulation out");
+  report_app->add_option("--cache-dir", report.cache_dir,
+                         "Cached sweeps (<key>.json) here (default: DIR/sim-cache)");
+  report_app->add_option("--gnuplot", report.gnuplot, "The gnuplot program")
+      ->capture_default_str();
+  report_app->add_option("--feet", report.sweep.feet, "Simulated feet, comma-separated")
+      ->capture_default_str();
+  report_app
+      ->add_option("--tensions", report.sweep.tensions,
+                   "Simulated tension points, comma-separated names or 0..4, or all")
+      ->capture_default_str();
+  report_app->add_option("--threads", report.sweep.threads, "Sweep worker threads (0: all cores)")
+      ->capture_default_str();
+  AddSimFlags(report_app, report.sweep.experiment);  // its --progress is the report's too
 
   Import2018Command import;
   CLI::App* import_app = app.add_subcommand(
@@ -413,6 +442,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*table_app) return RunTable(table, std::cout, std::cerr);
+    if (*report_app) return RunReport(report, std::cout, std::cerr);
     if (*import_app) return RunImport2018(import, std::cout, std::cerr);
     if (*sync_app) return RunSync(sync, std::cout, std::cerr);
     if (*log_app) return RunLog(log, std::cout, std::cerr);

@@ -6,6 +6,7 @@
 #include <iosfwd>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "liftoff/cli/commands.h"
 #include "liftoff/core/calibration.h"
@@ -14,6 +15,7 @@
 #include "liftoff/core/manifest.h"
 #include "liftoff/core/output.h"
 #include "liftoff/sync/lookup.h"
+#include "liftoff/sync/trial_analysis.h"
 
 namespace liftoff::cli {
 
@@ -51,5 +53,26 @@ int RefuseToOverwriteInputs(const std::vector<NamedPath>& outputs,
 
 /// Prints each line of a log's read report that a person should see ("warning: ...").
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err);
+
+/// A campaign's trials analysed the way `liftoff table` does.
+struct CampaignAnalysis {
+  TrialManifest manifest;
+  Calibration calibration;
+  sync::ManifestAnalysis analysis;
+  /// Per outcome, in the same order: the lines printed about it ("warning: ...",
+  /// "note: ...", "error: ...").
+  std::vector<std::vector<std::string>> notes;
+  /// The first failed trial's status (OK when none failed).
+  Status first_failure;
+};
+
+/// Loads the manifest (or 2018 folder) and the calibration, and analyses every trial
+/// (videos without times through video analysis, progress on `err` in `progress_mode`);
+/// each trial's notes go to `err` as they are found. A failing trial is a result, not an
+/// error: the error is for bad options, manifest or calibration.
+Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
+                                         const CalibrationChoice& calibration_choice,
+                                         const LookupChoice& lookup_choice,
+                                         std::string_view progress_mode, std::ostream& err);
 
 }  // namespace liftoff::cli

@@ -84,10 +84,72 @@ std::vector<NamedPath> TableInputs(const TableCommand& command, const TrialManif
   return inputs;
 }
 
+// The lines about one trial a person should see: log warnings, the video's brief and
+// warnings, the failure, the lookup's notes.
+void PrintOutcomeNotes(const sync::TrialOutcome& outcome, std::ostream& err) {
+  PrintLogWarnings(outcome.log_report, err);
+  if (outcome.video) {
+    err << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
+    for (const std::string& warning : outcome.video->warnings) {
+      err << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
+    }
+  }
+  if (!outcome.status.ok()) {
+    err << "error: " << outcome.status.ToString() << '\n';
+    return;
+  }
+  for (const std::string& warning : outcome.measurement->lookup.warnings) {
+    err << "note: " << outcome.trial.id << ": " << warning << '\n';
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
 // liftoff table
+
+Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
+                                         const CalibrationChoice& calibration_choice,
+                                         const LookupChoice& lookup_choice,
+                                         std::string_view progress_mode, std::ostream& err) {
+  // options, then inputs: manifest (or a 2018 folder read as one) and calibration
+  auto lookup = LookupOptionsFrom(lookup_choice);
+  if (!lookup.ok()) return lookup.status();
+  auto progress = VideoProgress::Create(progress_mode, err);
+  if (!progress.ok()) return progress.status();
+  CampaignAnalysis campaign;
+  auto manifest = LoadTrials(manifest_path, err);
+  if (!manifest.ok()) return manifest.status();
+  campaign.manifest = std::move(manifest).value();
+  auto calibration = ChooseCalibration(
+      calibration_choice, campaign.manifest.calibration_path.value_or(std::filesystem::path()));
+  if (!calibration.ok()) return calibration.status();
+  campaign.calibration = std::move(calibration).value();
+
+  // every trial through sync (videos without times through video analysis)
+  sync::AnalysisOptions options;
+  options.lookup = *lookup;
+  options.log.max_bad_lines = lookup_choice.max_bad_lines;
+  options.video_progress = [&](const TrialRecord& trial, int64_t frames_done, int64_t t_ns) {
+    progress->Show(trial.id, frames_done, t_ns);
+  };
+  campaign.analysis = sync::AnalyzeManifest(campaign.manifest, campaign.calibration, options);
+  progress->Done();
+
+  // what a person should know about each trial, on `err` and kept per trial
+  for (const sync::TrialOutcome& outcome : campaign.analysis.outcomes) {
+    std::ostringstream lines;
+    PrintOutcomeNotes(outcome, lines);
+    err << lines.str();
+    std::vector<std::string>& notes = campaign.notes.emplace_back();
+    std::istringstream split(lines.str());
+    for (std::string line; std::getline(split, line);) notes.push_back(line);
+    if (!outcome.status.ok() && campaign.first_failure.ok()) {
+      campaign.first_failure = outcome.status;
+    }
+  }
+  return campaign;
+}
 
 int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) {
   // flags
@@ -102,23 +164,6 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
                                             command.tables + "\""),
                        err);
   }
-  auto lookup = LookupOptionsFrom(command.lookup);
-  if (!lookup.ok()) return ReportError(lookup.status(), err);
-  auto progress = VideoProgress::Create(command.progress, err);
-  if (!progress.ok()) return ReportError(progress.status(), err);
-
-  // inputs: manifest (or a 2018 folder read as one), calibration, optional sim results
-  auto manifest = LoadTrials(command.manifest_path, err);
-  if (!manifest.ok()) return ReportError(manifest.status(), err);
-  auto calibration = ChooseCalibration(
-      command.calibration, manifest->calibration_path.value_or(std::filesystem::path()));
-  if (!calibration.ok()) return ReportError(calibration.status(), err);
-  if (const int refused = RefuseToOverwriteInputs(TableOutputs(command, *manifest),
-                                                  TableInputs(command, *manifest, *calibration),
-                                                  err);
-      refused != kExitOk) {
-    return refused;
-  }
   std::optional<stats::SimResults> sim = command.sim_results;
   if (!sim && !command.sim_path.empty()) {
     auto loaded = stats::LoadSimResults(command.sim_path);
@@ -126,34 +171,19 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
     sim = std::move(loaded).value();
   }
 
-  // every trial through sync (videos without times through video analysis); failures are
-  // reported and the rest still tabulated
-  sync::AnalysisOptions options;
-  options.lookup = *lookup;
-  options.log.max_bad_lines = command.lookup.max_bad_lines;
-  options.video_progress = [&](const TrialRecord& trial, int64_t frames_done, int64_t t_ns) {
-    progress->Show(trial.id, frames_done, t_ns);
-  };
-  const sync::ManifestAnalysis analysis = sync::AnalyzeManifest(*manifest, *calibration, options);
-  progress->Done();
-  Status first_failure;
-  for (const sync::TrialOutcome& outcome : analysis.outcomes) {
-    PrintLogWarnings(outcome.log_report, err);
-    if (outcome.video) {
-      err << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
-      for (const std::string& warning : outcome.video->warnings) {
-        err << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
-      }
-    }
-    if (!outcome.status.ok()) {
-      err << "error: " << outcome.status.ToString() << '\n';
-      if (first_failure.ok()) first_failure = outcome.status;
-      continue;
-    }
-    for (const std::string& warning : outcome.measurement->lookup.warnings) {
-      err << "note: " << outcome.trial.id << ": " << warning << '\n';
-    }
+  // every trial; failures are reported and the rest still tabulated
+  auto campaign = AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup,
+                                  command.progress, err);
+  if (!campaign.ok()) return ReportError(campaign.status(), err);
+  // nothing is written before this: no output may be one of the inputs
+  if (const int refused = RefuseToOverwriteInputs(
+          TableOutputs(command, campaign->manifest),
+          TableInputs(command, campaign->manifest, campaign->calibration), err);
+      refused != kExitOk) {
+    return refused;
   }
+  const sync::ManifestAnalysis& analysis = campaign->analysis;
+  const Status first_failure = campaign->first_failure;
 
   // tables
   const std::vector<stats::TrialValue> values = analysis.Values();

@@ -147,13 +147,8 @@ Status RenameFields(const Status& status) {
   return status.WithContext("simulation options");
 }
 
-// the model file a command reads: --model, else the bundled one
-std::filesystem::path ModelPath(const SimExperimentChoice& choice) {
-  return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
-}
-
 Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice) {
-  return sim::LoadModelDescription(ModelPath(choice));
+  return sim::LoadModelDescription(ModelPathFrom(choice));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -403,6 +398,10 @@ void PrintSweep(const sim::SweepResult& sweep, std::ostream& out) {
 // ---------------------------------------------------------------------------------------
 // options from flags
 
+std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice) {
+  return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
+}
+
 Result<sim::ExperimentOptions> ExperimentOptionsFrom(const SimExperimentChoice& choice) {
   sim::ExperimentOptions options;
   const NumberRange non_negative = {.min = 0.0};
@@ -603,7 +602,7 @@ int RunSimRun(const SimRunCommand& command, std::ostream& out, std::ostream& err
   if (!progress.ok()) return ReportError(progress.status(), err);
   if (const int refused =
           RefuseToOverwriteInputs({{"--curves", command.curves_path}},
-                                  {{"--model", ModelPath(command.experiment)}}, err);
+                                  {{"--model", ModelPathFrom(command.experiment)}}, err);
       refused != kExitOk) {
     return refused;
   }
@@ -681,25 +680,23 @@ stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string
   return results;
 }
 
-int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
-  // flags
+Result<sim::SweepOptions> SweepOptionsFrom(const SimSweepCommand& command) {
   auto base = ExperimentOptionsFrom(command.experiment);
-  if (!base.ok()) return ReportError(base.status(), err);
+  if (!base.ok()) return base.status();
   sim::SweepOptions options;
   options.base = *base;
   options.threads = command.threads;
   options.stop_once_decided = !command.full_ramp;
   if (command.threads < 0) {
-    return ReportError(InvalidArgumentError("--threads: expected an integer >= 0, got " +
-                                            std::to_string(command.threads)),
-                       err);
+    return InvalidArgumentError("--threads: expected an integer >= 0, got " +
+                                            std::to_string(command.threads));
   }
   options.feet.clear();
   for (const std::string& name : SplitCommas(command.feet)) {
     auto foot = FootFlag("--feet", name);
-    if (!foot.ok()) return ReportError(foot.status(), err);
+    if (!foot.ok()) return foot.status();
     if (std::find(options.feet.begin(), options.feet.end(), *foot) != options.feet.end()) {
-      return ReportError(InvalidArgumentError("--feet: foot " + name + " appears twice"), err);
+      return InvalidArgumentError("--feet: foot " + name + " appears twice");
     }
     options.feet.push_back(*foot);
   }
@@ -708,32 +705,47 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
     for (const std::string& name : SplitCommas(command.tensions)) {
       auto point = sim::PaperTensionPointByName(name);
       if (!point.ok()) {
-        return ReportError(InvalidArgumentError("--tensions: expected all or a comma-separated "
+        return InvalidArgumentError("--tensions: expected all or a comma-separated "
                                                 "list of low, med-low, mean, med-high, high "
                                                 "(or 0..4), got \"" +
-                                                name + "\""),
-                           err);
+                                                name + "\"");
       }
       for (const TensionPoint& seen : options.tension_points) {
         if (seen.name == point->name) {
-          return ReportError(InvalidArgumentError("--tensions: " + point->name + " appears twice"),
-                             err);
+          return InvalidArgumentError("--tensions: " + point->name + " appears twice");
         }
       }
       options.tension_points.push_back(*point);
     }
   }
+  return options;
+}
+
+Result<sim::SweepResult> RunSweepShowingProgress(const SimSweepCommand& command,
+                                                 std::ostream& err) {
+  LIFTOFF_ASSIGN_OR_RETURN(sim::SweepOptions options, SweepOptionsFrom(command));
+  LIFTOFF_ASSIGN_OR_RETURN(SimProgress progress,
+                           SimProgress::Create(command.experiment.progress, err));
+  LIFTOFF_ASSIGN_OR_RETURN(sim::ModelDescription description, LoadDescription(command.experiment));
+  const int64_t started_ns = MonotonicNowNs();
+  auto sweep = sim::RunSweep(description, options, [&](const sim::SweepProgress& report) {
+    progress.ShowSweep(report);
+  });
+  progress.Done();
+  if (!sweep.ok()) return sweep.status();
+  const double wall_s = SecondsFromNs(MonotonicNowNs() - started_ns);
+  err << "sim: " << Plural(static_cast<int64_t>(sweep->runs.size()), "run") << " in "
+      << FormatFixed(wall_s, 2) << " s wall on " << Plural(sweep->threads, "thread") << '\n';
+  return sweep;
+}
+
+int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
   const auto table_format = stats::ParseTableFormat(command.format);
   if (!table_format) {
     return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
                                             command.format + "\""),
                        err);
   }
-  auto progress = SimProgress::Create(command.experiment.progress, err);
-  if (!progress.ok()) return ReportError(progress.status(), err);
-  auto description = LoadDescription(command.experiment);
-  if (!description.ok()) return ReportError(description.status(), err);
-
   // the hardware trials are read before the sweep: a missing or broken manifest fails in
   // a second, not after the whole sweep
   if (!command.hardware_path.empty()) {
@@ -743,22 +755,13 @@ int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream&
   }
   if (const int refused = RefuseToOverwriteInputs(
           {{"--output", command.output_path}},
-          {{"--model", ModelPath(command.experiment)}, {"--hardware", command.hardware_path}},
+          {{"--model", ModelPathFrom(command.experiment)}, {"--hardware", command.hardware_path}},
           err);
       refused != kExitOk) {
     return refused;
   }
-
-  // the sweep
-  const int64_t started_ns = MonotonicNowNs();
-  auto sweep = sim::RunSweep(*description, options, [&](const sim::SweepProgress& report) {
-    progress->ShowSweep(report);
-  });
-  progress->Done();
+  auto sweep = RunSweepShowingProgress(command, err);
   if (!sweep.ok()) return ReportError(sweep.status(), err);
-  const double wall_s = SecondsFromNs(MonotonicNowNs() - started_ns);
-  err << "sim: " << Plural(static_cast<int64_t>(sweep->runs.size()), "run") << " in "
-      << FormatFixed(wall_s, 2) << " s wall on " << Plural(sweep->threads, "thread") << '\n';
 
   // the results file, then what to print
   const std::string overrides = DescribeOverrides(command.experiment);
@@ -826,7 +829,7 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
 
   if (const int refused =
           RefuseToOverwriteInputs({{"--output", command.output_path}},
-                                  {{"--model", ModelPath(command.experiment)}}, err);
+                                  {{"--model", ModelPathFrom(command.experiment)}}, err);
       refused != kExitOk) {
     return refused;
   }

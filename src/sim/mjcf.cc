@@ -6,6 +6,7 @@
 
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/markup.h"
 #include "liftoff/core/text.h"
 
 namespace liftoff::sim {
@@ -32,21 +33,6 @@ std::string Vec(const Vec3& v) { return Num(v.x()) + " " + Num(v.y()) + " " + Nu
 
 std::string QuatText(const Quat& q) {
   return Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) + " " + Num(q.z());
-}
-
-// An attribute value with XML's special characters escaped.
-std::string Attr(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 // Comment text: XML forbids "--" inside a comment.
@@ -93,7 +79,7 @@ class Writer {
 
   std::string Write() {
     Header();
-    out_ << "<mujoco model=\"" << Attr(model_.description.name) << "\">\n";
+    out_ << "<mujoco model=\"" << EscapeMarkup(model_.description.name) << "\">\n";
     Settings();
     World();
     Tendons();
@@ -222,12 +208,12 @@ class Writer {
   void FreeBody(int b) {
     const Body& body = model_.bodies[Index(b)];
     const Vec3 position = body.initial_position_m + Vec3(0.0, 0.0, options_.lift_m);
-    std::string open = "<body name=\"" + Attr(body.name) + "\" pos=\"" + Vec(position) + "\"";
+    std::string open = "<body name=\"" + EscapeMarkup(body.name) + "\" pos=\"" + Vec(position) + "\"";
     if (!IsIdentityQuat(body.initial_orientation)) {
       open += " quat=\"" + QuatText(body.initial_orientation) + "\"";
     }
     Line(2, open + ">");
-    Line(3, "<freejoint name=\"" + Attr(MjcfFreeJointName(model_, b)) + "\"/>");
+    Line(3, "<freejoint name=\"" + EscapeMarkup(MjcfFreeJointName(model_, b)) + "\"/>");
     BodyContents(b, 3);
     // hinge children of this body
     for (size_t h = 0; h < model_.hinges.size(); ++h) {
@@ -239,7 +225,7 @@ class Writer {
   void HingeChild(int h, int depth) {
     const Hinge& hinge = model_.hinges[Index(h)];
     const Body& child = model_.bodies[Index(hinge.child)];
-    std::string open = "<body name=\"" + Attr(child.name) + "\" pos=\"" +
+    std::string open = "<body name=\"" + EscapeMarkup(child.name) + "\" pos=\"" +
                        Vec(hinge.child_position_in_parent_m) + "\"";
     if (!IsIdentityQuat(hinge.child_orientation_in_parent)) {
       open += " quat=\"" + QuatText(hinge.child_orientation_in_parent) + "\"";
@@ -249,7 +235,7 @@ class Writer {
     const Quat child_from_parent = hinge.child_orientation_in_parent.conjugate();
     const Vec3 point = child_from_parent * (hinge.point_m - hinge.child_position_in_parent_m);
     const Vec3 axis = child_from_parent * hinge.axis;
-    std::string joint = "<joint name=\"" + Attr(hinge.name) + "\" type=\"hinge\" pos=\"" +
+    std::string joint = "<joint name=\"" + EscapeMarkup(hinge.name) + "\" type=\"hinge\" pos=\"" +
                         Vec(point) + "\" axis=\"" + Vec(axis) + "\"";
     if (options_.hinge_drive == MjcfHingeDrive::kPositionActuator) {
       joint += " damping=\"" + Num(options_.hinge_damping_n_m_s_per_rad) + "\"";
@@ -267,14 +253,14 @@ class Writer {
                     "\" fullinertia=\"" + Num(inertia(0, 0)) + " " + Num(inertia(1, 1)) + " " +
                     Num(inertia(2, 2)) + " " + Num(inertia(0, 1)) + " " + Num(inertia(0, 2)) + " " +
                     Num(inertia(1, 2)) + "\"/>");
-    const std::string prefix = Attr(body.name) + "/";
+    const std::string prefix = EscapeMarkup(body.name) + "/";
     for (const Rod& rod : body.rods) {
       const int type =
           rod.collides
               ? ((contact.spine_ground ? kGroundBit : 0) | (contact.spine_self ? kSpineSelfBit : 0))
               : 0;
       const int affinity = rod.collides && contact.spine_self ? kSpineSelfBit : 0;
-      Line(depth, "<geom name=\"" + prefix + Attr(rod.name) + "\" type=\"capsule\" fromto=\"" +
+      Line(depth, "<geom name=\"" + prefix + EscapeMarkup(rod.name) + "\" type=\"capsule\" fromto=\"" +
                       Vec(rod.from_m) + " " + Vec(rod.to_m) + "\" size=\"" + Num(rod.radius_m) +
                       "\"" + Collision(type, affinity) +
                       (type != 0 ? FrictionAttributes(SpineFriction()) : "") +
@@ -282,7 +268,7 @@ class Writer {
     }
     for (const Box& box : body.boxes) {
       const int type = box.collides && contact.spine_ground ? kGroundBit : 0;
-      Line(depth, "<geom name=\"" + prefix + Attr(box.name) + "\" type=\"box\" pos=\"" +
+      Line(depth, "<geom name=\"" + prefix + EscapeMarkup(box.name) + "\" type=\"box\" pos=\"" +
                       Vec(box.center_m) + "\" size=\"" + Vec(box.half_size_m) + "\"" +
                       Collision(type, 0) + (type != 0 ? FrictionAttributes(SpineFriction()) : "") +
                       (box.collides ? " rgba=\"0.8 0.65 0.45 1\"" : " rgba=\"0.8 0.65 0.45 0.5\"") +
@@ -294,7 +280,7 @@ class Writer {
       const std::string rgba =
           foot ? FootRgba(model_.feet[Index(sphere.foot_index)].foot) : "0.8 0.65 0.45 1";
       Line(depth,
-           "<geom name=\"" + prefix + Attr(sphere.name) + "\" type=\"sphere\" pos=\"" +
+           "<geom name=\"" + prefix + EscapeMarkup(sphere.name) + "\" type=\"sphere\" pos=\"" +
                Vec(sphere.center_m) + "\" size=\"" + Num(sphere.radius_m) + "\"" +
                Collision(type, 0) +
                (type != 0 ? FrictionAttributes(foot ? contact.friction : SpineFriction()) : "") +
@@ -313,7 +299,7 @@ class Writer {
       for (bool from_end : {true, false}) {
         if ((from_end ? cable.body_a : cable.body_b) != b) continue;
         Line(depth, "<site name=\"" +
-                        Attr(MjcfCableSiteName(model_, static_cast<int>(c), from_end)) +
+                        EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), from_end)) +
                         "\" pos=\"" + Vec(from_end ? cable.anchor_a_m : cable.anchor_b_m) + "\"/>");
       }
     }
@@ -340,13 +326,13 @@ class Writer {
         last_group = cable.group;
       }
       const std::string& material = model_.cable_groups[Index(cable.group)].material;
-      Line(2, "<spatial name=\"" + Attr(cable.name) + "\" springlength=\"" +
+      Line(2, "<spatial name=\"" + EscapeMarkup(cable.name) + "\" springlength=\"" +
                   Num(cable.rest_length_m) + "\" stiffness=\"0\" damping=\"0\" rgba=\"" +
                   CableRgba(material) + "\">");
       Line(3,
-           "<site site=\"" + Attr(MjcfCableSiteName(model_, static_cast<int>(c), true)) + "\"/>");
+           "<site site=\"" + EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), true)) + "\"/>");
       Line(3,
-           "<site site=\"" + Attr(MjcfCableSiteName(model_, static_cast<int>(c), false)) + "\"/>");
+           "<site site=\"" + EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), false)) + "\"/>");
       Line(2, "</spatial>");
     }
     Line(1, "</tendon>");
@@ -359,9 +345,9 @@ class Writer {
       for (size_t h = 0; h < model_.hinges.size(); ++h) {
         const Hinge& hinge = model_.hinges[h];
         Line(2, "<joint name=\"" +
-                    Attr(MjcfHingeDriveElementName(model_, static_cast<int>(h),
+                    EscapeMarkup(MjcfHingeDriveElementName(model_, static_cast<int>(h),
                                                    options_.hinge_drive)) +
-                    "\" joint1=\"" + Attr(hinge.name) + "\" polycoef=\"0 0 0 0 0\" solref=\"" +
+                    "\" joint1=\"" + EscapeMarkup(hinge.name) + "\" polycoef=\"0 0 0 0 0\" solref=\"" +
                     Num(HingeTimeConstant()) + " 1\" solimp=\"" + Num(options_.hinge_impedance) +
                     " " + Num(options_.hinge_impedance) + " 0.001\"/>");
       }
@@ -373,8 +359,8 @@ class Writer {
       const Hinge& hinge = model_.hinges[h];
       Line(2,
            "<position name=\"" +
-               Attr(MjcfHingeDriveElementName(model_, static_cast<int>(h), options_.hinge_drive)) +
-               "\" joint=\"" + Attr(hinge.name) + "\" kp=\"" +
+               EscapeMarkup(MjcfHingeDriveElementName(model_, static_cast<int>(h), options_.hinge_drive)) +
+               "\" joint=\"" + EscapeMarkup(hinge.name) + "\" kp=\"" +
                Num(options_.hinge_gain_n_m_per_rad) +
                "\" ctrllimited=\"true\" ctrlrange=\"-3.14159 3.14159\"/>");
     }

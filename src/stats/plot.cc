@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "liftoff/core/markup.h"
 #include "liftoff/core/text.h"
 
 namespace liftoff::stats {
@@ -13,21 +14,6 @@ namespace {
 
 // Colours of the feet's tape (A blue, B orange, C purple, D red), as the videos show them.
 constexpr std::array<const char*, 4> kFootColour = {"#1f5fbf", "#e07b1a", "#7b3fa0", "#c62828"};
-
-// Text as SVG character data.
-std::string Escape(const std::string& text) {
-  std::string escaped;
-  for (char c : text) {
-    switch (c) {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
-    }
-  }
-  return escaped;
-}
 
 std::string Px(double value) { return FormatFixed(value, 1); }
 
@@ -90,7 +76,7 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
   svg << R"(<rect width="100%" height="100%" fill="white"/>)" << '\n';
   svg << R"(<text x=")" << Px(options.width_px / 2.0) << R"(" y="24" text-anchor="middle" )"
       << R"(font-size="15" font-weight="bold">)"
-      << Escape(table.title.empty() ? "Absolute vertebra rotation at liftoff (rad)" : table.title)
+      << EscapeMarkup(table.title.empty() ? "Absolute vertebra rotation at liftoff (rad)" : table.title)
       << "</text>\n";
 
   // grid and axis labels every 0.05 rad
@@ -142,7 +128,7 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
             << R"(" stroke=")" << colour << R"(" stroke-opacity="0.5"/>)" << '\n';
       }
       svg << R"(<circle cx=")" << Px(x) << R"(" cy=")" << Px(y_of(trial.liftoff_rad))
-          << R"(" r="3.5" fill=")" << colour << R"("><title>)" << Escape(trial.trial_id) << ": "
+          << R"(" r="3.5" fill=")" << colour << R"("><title>)" << EscapeMarkup(trial.trial_id) << ": "
           << FormatFixed(trial.liftoff_rad, 3) << " rad</title></circle>\n";
     }
 
@@ -167,8 +153,8 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
       << R"(" font-size="11">dots: hardware trials (whisker: uncertainty interval); black: )"
       << R"(mean and 95 % CI; grey band: simulated range over tension points</text>)" << '\n';
   svg << R"(<text x=")" << Px(left) << R"(" y=")" << Px(bottom + 56)
-      << R"(" font-size="11" fill="#444">calibration: )" << Escape(table.calibration)
-      << "; lookup: " << Escape(table.lookup_rule) << "</text>\n";
+      << R"(" font-size="11" fill="#444">calibration: )" << EscapeMarkup(table.calibration)
+      << "; lookup: " << EscapeMarkup(table.lookup_rule) << "</text>\n";
   svg << "</svg>\n";
   return svg.str();
 }

@@ -27,12 +27,7 @@ using liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
 
 CommandRun RunTableCommand(const TableCommand& command) {
-  std::ostringstream out, err;
-  CommandRun run;
-  run.code = RunTable(command, out, err);
-  run.out = out.str();
-  run.err = err.str();
-  return run;
+  return liftoff::testing::RunInProcess(RunTable, command);
 }
 
 CommandRun RunBinary(const std::string& arguments, const ScratchDir& scratch) {

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -48,6 +49,17 @@ struct CommandRun {
 /// capturing standard output and error in files under `scratch`.
 CommandRun RunCommand(const std::filesystem::path& binary, const std::string& arguments,
                       const ScratchDir& scratch);
+/// Runs a command's Run function in this process: `run(command, out, err)` with its
+/// exit code and what it wrote (liftoff::cli's RunTable, RunReport, ...).
+template <typename Command, typename RunFunction>
+CommandRun RunInProcess(RunFunction run, const Command& command) {
+  std::ostringstream out, err;
+  CommandRun result;
+  result.code = run(command, out, err);
+  result.out = out.str();
+  result.err = err.str();
+  return result;
+}
 /// `path` in double quotes, for a shell command line.
 std::string Quoted(const std::filesystem::path& path);
 

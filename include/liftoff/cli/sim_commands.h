@@ -86,6 +86,9 @@ struct SimExperimentChoice {
 /// (0, 1000], got 0".
 Result<sim::ExperimentOptions> ExperimentOptionsFrom(const SimExperimentChoice& choice);
 
+/// The model file the choice names: its model_path, else sim::DefaultModelPath().
+std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice);
+
 /// The flags of `choice` that differ from the defaults, as a command line would give them
 /// ("--friction 0.25 --attachment node"); empty when none.
 std::string DescribeOverrides(const SimExperimentChoice& choice);
@@ -131,6 +134,14 @@ struct SimSweepCommand {
   LookupChoice lookup;
 };
 int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err);
+
+/// The sweep options `command` asks for (feet, tensions, threads, full ramp and the
+/// experiment); kInvalidArgument naming the flag.
+Result<sim::SweepOptions> SweepOptionsFrom(const SimSweepCommand& command);
+/// Runs the sweep `command` asks for with its progress display on `err`, then a line with
+/// the run count and wall time. Only the sweep's fields of `command` are used.
+Result<sim::SweepResult> RunSweepShowingProgress(const SimSweepCommand& command,
+                                                 std::ostream& err);
 
 /// `liftoff sim export-mjcf -o FILE.xml`: the model as MuJoCo MJCF (sim/mjcf.h). The
 /// file's time step is MjcfOptions' default unless the experiment's --dt is given (its

@@ -1,0 +1,45 @@
+// `liftoff report MANIFEST -o DIR`: the campaign in one command. Every trial analysed as
+// `liftoff table` does (a failing trial reported and left out), the simulated column from
+// the tension sweep (run, or read from a cache keyed by the model file's bytes, the
+// calibration and every experiment option), and in DIR: the tables (Markdown and CSV), the
+// figures (gnuplot scripts with their data beside them, drawn as PNG and SVG when gnuplot
+// is on the PATH), report.md and a self-contained report.html. Layout: docs/cli.md,
+// "liftoff report".
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "liftoff/cli/commands.h"
+#include "liftoff/cli/sim_commands.h"
+
+namespace liftoff::cli {
+
+struct ReportCommand {
+  /// Trial manifest (JSON), or a 2018 Laika folder.
+  std::filesystem::path manifest_path;
+  /// Folder the report is written to (created when missing); must hold none of the inputs.
+  std::filesystem::path output_dir;
+  CalibrationChoice calibration;
+  LookupChoice lookup;
+  /// The sweep of the simulated column: its experiment, feet, tensions, threads and
+  /// full_ramp (its output, hardware and format fields are not used). Its
+  /// experiment.progress (auto, live, lines or off) is the whole report's progress on
+  /// stderr: video analysis and sweep.
+  SimSweepCommand sweep;
+  /// Leave the simulation out (no sweep, no Figure 7).
+  bool no_sim = false;
+  /// Folder of cached sweeps (<key>.json); empty: DIR/sim-cache.
+  std::filesystem::path cache_dir;
+  /// The gnuplot program (found on the PATH unless a path is given).
+  std::string gnuplot = "gnuplot";
+};
+
+/// Writes the report. Exit code: 0 when every trial was analysed and every file written;
+/// a failing trial's class (ExitCodeFor) after the report of the others is written, as
+/// `liftoff table` does; gnuplot missing or failing is a warning (data and scripts are
+/// still written).
+int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err);
+
+}  // namespace liftoff::cli

@@ -1,0 +1,627 @@
+#include "liftoff/cli/report_command.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/core/file.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/markup.h"
+#include "liftoff/core/text.h"
+#include "liftoff/core/version.h"
+#include "liftoff/stats/sim_results.h"
+#include "liftoff/stats/table.h"
+
+extern char** environ;
+
+namespace liftoff::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr std::string_view kCacheFormat = "liftoff-sim-cache";
+constexpr int kCacheVersion = 1;
+
+// ---------------------------------------------------------------------------------------
+// inputs
+
+// kInvalidArgument when `input` lies inside `dir`: the report never writes over an input
+Status CheckOutsideOutput(const fs::path& input, const fs::path& dir, std::string_view what) {
+  std::error_code error;
+  const fs::path inside = fs::weakly_canonical(fs::absolute(input), error);
+  fs::path folder = fs::weakly_canonical(fs::absolute(dir), error);
+  if (folder.filename().empty()) folder = folder.parent_path();
+  const auto [folder_end, unused] =
+      std::mismatch(folder.begin(), folder.end(), inside.begin(), inside.end());
+  if (folder_end != folder.end()) return Status::Ok();
+  return InvalidArgumentError("--output: " + dir.string() + " holds the " + std::string(what) +
+                              " " + input.string() +
+                              "; choose a folder without inputs (the report never overwrites one)");
+}
+
+// every file the report reads: manifest, calibration, logs, videos, model
+Status CheckInputsOutsideOutput(const ReportCommand& command, const CampaignAnalysis& campaign) {
+  const fs::path& dir = command.output_dir;
+  if (fs::is_regular_file(command.manifest_path)) {
+    LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(command.manifest_path, dir, "manifest"));
+  }
+  fs::path calibration = command.calibration.calibration_path;
+  if (calibration.empty()) calibration = campaign.manifest.calibration_path.value_or(fs::path());
+  if (calibration.empty()) calibration = DefaultCalibrationPath();
+  LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(calibration, dir, "calibration"));
+  for (const TrialRecord& trial : campaign.manifest.trials) {
+    LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(trial.log_path, dir, "log of " + trial.id));
+    if (trial.video_path) {
+      LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(*trial.video_path, dir, "video of " + trial.id));
+    }
+  }
+  if (command.no_sim) return Status::Ok();
+  return CheckOutsideOutput(ModelPathFrom(command.sweep.experiment), dir, "model");
+}
+
+// ---------------------------------------------------------------------------------------
+// the simulated column, from the cache or a fresh sweep
+
+// One run's targeted foot: height above its reference against |rotation| (Figure 7).
+struct SimCurve {
+  std::string foot;
+  std::string tension_point;
+  std::vector<double> rotation_rad;
+  std::vector<double> height_m;
+};
+
+// The simulation results and each standing run's curve, in sweep order.
+struct SimColumn {
+  stats::SimResults results;
+  std::vector<SimCurve> curves;
+  fs::path cache_path;
+  bool from_cache = false;
+};
+
+// 64-bit FNV-1a: a stable key across machines and runs (not a security hash)
+std::string HashHex(std::string_view bytes) {
+  uint64_t hash = 14695981039346656037ULL;
+  for (const char byte : bytes) {
+    hash ^= static_cast<unsigned char>(byte);
+    hash *= 1099511628211ULL;
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+// what the sweep's values depend on: model bytes, calibration, every experiment option,
+// the feet and tension points, the ramp mode and the software version
+Result<std::string> CacheKey(const ReportCommand& command, const Calibration& calibration) {
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string model,
+                           ReadWholeFile(ModelPathFrom(command.sweep.experiment)));
+  const std::string key_text = "model\n" + model + "\ncalibration\n" +
+                               CalibrationToJson(calibration).dump() + "\nexperiment\n" +
+                               DescribeOverrides(command.sweep.experiment) + "\nfeet\n" +
+                               command.sweep.feet + "\ntensions\n" + command.sweep.tensions +
+                               "\nfull_ramp\n" + (command.sweep.full_ramp ? "1" : "0") +
+                               "\nversion\n" + kVersion;
+  return HashHex(key_text);
+}
+
+// the targeted foot's |rotation| and height above its reference, per run that stood
+std::vector<SimCurve> CurvesFromSweep(const sim::SweepResult& sweep) {
+  std::vector<SimCurve> curves;
+  for (const sim::SweepRun& run : sweep.runs) {
+    if (!run.Stood()) continue;
+    SimCurve& curve = curves.emplace_back();
+    curve.foot = FootName(run.foot);
+    curve.tension_point = run.tension_point.name;
+    for (const sim::CurvePoint& point : run.result.curve) {
+      curve.rotation_rad.push_back(std::abs(point.rotation_rad));
+      curve.height_m.push_back(point.height_m[static_cast<size_t>(run.foot)]);
+    }
+  }
+  return curves;
+}
+
+json CurvesToJson(const std::vector<SimCurve>& curves) {
+  json array = json::array();
+  for (const SimCurve& curve : curves) {
+    array.push_back({{"foot", curve.foot},
+                     {"tension_point", curve.tension_point},
+                     {"rotation_rad", curve.rotation_rad},
+                     {"height_m", curve.height_m}});
+  }
+  return array;
+}
+
+// a cache file: its format and version, the simulation results and the curves
+Result<SimColumn> LoadCachedColumn(const fs::path& path) {
+  LIFTOFF_ASSIGN_OR_RETURN(const json document, LoadJsonFile(path));
+  JsonReader reader(document, path.string());
+  if (reader.String("format") != kCacheFormat) {
+    reader.Fail("format", "expected \"" + std::string(kCacheFormat) + "\"");
+  }
+  reader.Integer("version", {.min = kCacheVersion, .max = kCacheVersion});
+  reader.String("key");
+  const json* results = reader.Raw("results");
+  if (results == nullptr) reader.Fail("results", "missing");
+  SimColumn column;
+  for (JsonReader& entry : reader.ObjectArray("curves")) {
+    SimCurve& curve = column.curves.emplace_back();
+    curve.foot = entry.String("foot");
+    curve.tension_point = entry.String("tension_point");
+    curve.rotation_rad = entry.NumberArray("rotation_rad");
+    curve.height_m = entry.NumberArray("height_m");
+  }
+  const Status read = reader.Finish();
+  if (!read.ok()) return Status(read.code(), read.message() + "; delete the file to rerun the sweep");
+  LIFTOFF_ASSIGN_OR_RETURN(column.results, stats::SimResultsFromJson(*results, path.string()));
+  column.cache_path = path;
+  column.from_cache = true;
+  return column;
+}
+
+Result<SimColumn> SimulatedColumn(const ReportCommand& command, const Calibration& calibration,
+                                  std::ostream& err) {
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string key, CacheKey(command, calibration));
+  const fs::path cache_dir =
+      command.cache_dir.empty() ? command.output_dir / "sim-cache" : command.cache_dir;
+  const fs::path path = cache_dir / (key + ".json");
+  if (fs::exists(path)) return LoadCachedColumn(path);
+
+  LIFTOFF_ASSIGN_OR_RETURN(const sim::SweepResult sweep,
+                           RunSweepShowingProgress(command.sweep, err));
+  const std::string overrides = DescribeOverrides(command.sweep.experiment);
+  SimColumn column;
+  column.results = SimResultsFromSweep(
+      sweep, "liftoff sim sweep" + (overrides.empty() ? "" : " " + overrides));
+  column.results.source = path.string();
+  column.curves = CurvesFromSweep(sweep);
+  column.cache_path = path;
+  const json document = {{"format", kCacheFormat},
+                         {"version", kCacheVersion},
+                         {"key", key},
+                         {"results", stats::SimResultsToJson(column.results)},
+                         {"curves", CurvesToJson(column.curves)}};
+  LIFTOFF_RETURN_IF_ERROR(WriteJsonFile(path, document));
+  return column;
+}
+
+// ---------------------------------------------------------------------------------------
+// figures: data and a gnuplot script each, drawn when gnuplot is there
+
+struct Figure {
+  std::string name;
+  std::string title;
+  std::string data;
+  /// The plot commands; the script around them sets the terminals.
+  std::string body;
+};
+
+// a string gnuplot reads as one field of a data file
+std::string DataText(std::string_view text) {
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? '\'' : c;
+  return quoted + "\"";
+}
+
+// the script: the body drawn once as PNG and once as SVG, beside the script
+std::string FigureScript(const Figure& figure) {
+  return "# liftoff report: " + figure.title +
+         ".\n# Data: " + figure.name + ".dat. Restyle here and rerun `gnuplot " + figure.name +
+         ".gp` in this folder.\n"
+         "do for [format in \"png svg\"] {\n"
+         "  if (format eq \"png\") {\n"
+         "    set terminal pngcairo size 1200,800 font \",11\"\n"
+         "  } else {\n"
+         "    set terminal svg size 1200,800 font \"sans,11\"\n"
+         "  }\n"
+         "  set output \"" + figure.name + ".\".format\n" +
+         figure.body + "  unset output\n}\n";
+}
+
+// (a) each trial's liftoff rotation with its interval, the simulated values of its foot
+Figure TrialsFigure(const std::vector<stats::TrialValue>& values, const stats::SimResults* sim) {
+  Figure figure{"trials", "liftoff rotation per trial beside the simulation", "", ""};
+  std::string& data = figure.data;
+  data = "# block 0: index rotation_rad lower_rad upper_rad trial foot\n";
+  std::map<Foot, std::pair<size_t, size_t>> span_by_foot;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const stats::TrialValue& value = values[i];
+    if (!std::isfinite(value.liftoff_rad)) continue;
+    const bool interval = std::isfinite(value.lower_rad) && std::isfinite(value.upper_rad);
+    data += std::to_string(i) + " " + FormatNumber(value.liftoff_rad) + " " +
+            FormatNumber(interval ? value.lower_rad : value.liftoff_rad) + " " +
+            FormatNumber(interval ? value.upper_rad : value.liftoff_rad) + " " +
+            DataText(value.trial_id) + " " + std::string(FootName(value.foot)) + "\n";
+    auto [entry, added] = span_by_foot.try_emplace(value.foot, i, i);
+    if (!added) entry->second.second = i;
+  }
+  data += "\n\n# block 1: from_index to_index liftoff_rad tension_point (simulation)\n";
+  bool any_sim = false;
+  for (const stats::SimRun& run : sim ? sim->runs : std::vector<stats::SimRun>()) {
+    const auto span = span_by_foot.find(run.foot);
+    if (!run.stood || !run.liftoff_rad || span == span_by_foot.end()) continue;
+    data += FormatFixed(static_cast<double>(span->second.first) - 0.4, 1) + " " +
+            FormatFixed(static_cast<double>(span->second.second) + 0.4, 1) + " " +
+            FormatNumber(*run.liftoff_rad) + " " + DataText(run.tension_point) + "\n";
+    any_sim = true;
+  }
+  if (!any_sim) data += "-1 -1 0 \"none\"\n";  // an empty block would stop gnuplot
+  figure.body =
+      "  set title \"Rotation at liftoff per trial: hardware (interval) beside simulation\"\n"
+      "  set ylabel \"|vertebra rotation| at liftoff (rad)\"\n"
+      "  set xlabel \"trial\"\n"
+      "  set xrange [-1:" + std::to_string(values.size()) + "]\n"
+      "  set grid ytics\n"
+      "  set key top left\n"
+      "  plot \"trials.dat\" index 0 using 1:2:3:4:xticlabels(5) with yerrorbars pt 7 lc rgb "
+      "\"#1f77b4\" title \"hardware\", \\\n"
+      "       \"\" index 1 using 1:3:($2-$1):(0) with vectors nohead lw 2 lc rgb \"#d62728\" "
+      "title \"simulation (per tension point)\", \\\n"
+      "       \"\" index 1 using 2:3:4 with labels left offset 0.5,0 font \",8\" notitle\n";
+  return figure;
+}
+
+// (b) the paper's Figure 7: per foot, the simulated height against |rotation| for each
+// tension point, the hardware's liftoff range as dashed vertical lines
+std::optional<Figure> Figure7(const std::vector<SimCurve>& curves,
+                             const stats::ResultsTable& table) {
+  if (curves.empty()) return std::nullopt;
+  Figure figure{"figure7", "foot height against rotation per tension point (paper Figure 7)",
+                "", ""};
+  std::map<std::string, std::vector<std::pair<int, std::string>>> blocks_by_foot;
+  std::map<std::string, double> max_rotation_by_foot;  // each panel's x range, rad
+  int block = 0;
+  for (const SimCurve& curve : curves) {
+    double& max_rotation = max_rotation_by_foot[curve.foot];
+    figure.data += "# block " + std::to_string(block) + ": foot " + curve.foot + ", tension " +
+                   curve.tension_point + ": rotation_rad height_mm\n";
+    for (size_t i = 0; i < curve.rotation_rad.size() && i < curve.height_m.size(); ++i) {
+      max_rotation = std::max(max_rotation, curve.rotation_rad[i]);
+      figure.data += FormatNumber(curve.rotation_rad[i]) + " " +
+                     FormatNumber(curve.height_m[i] * 1e3) + "\n";
+    }
+    figure.data += "\n\n";
+    blocks_by_foot[curve.foot].emplace_back(block++, curve.tension_point);
+  }
+  const size_t panels = blocks_by_foot.size();
+  figure.body = "  set multiplot layout " + std::to_string(panels > 2 ? 2 : 1) + "," +
+                std::to_string(panels > 1 ? 2 : 1) +
+                " title \"Simulated foot height against rotation; hardware liftoff range "
+                "dashed\"\n"
+                "  set xlabel \"|vertebra rotation| (rad)\"\n"
+                "  set ylabel \"foot height above reference (mm)\"\n"
+                "  set grid\n  set key top left\n";
+  for (const auto& [foot, blocks] : blocks_by_foot) {
+    figure.body += "  set title \"foot " + foot + "\"\n  unset arrow\n";
+    double max_x = max_rotation_by_foot[foot];
+    for (const stats::FootRow& row : table.rows) {
+      if (FootName(row.foot) != foot || row.hardware.n == 0) continue;
+      max_x = std::max(max_x, row.hardware.max);
+      for (const double x : {row.hardware.min, row.hardware.max}) {
+        figure.body += "  set arrow from " + FormatNumber(x) + ", graph 0 to " +
+                       FormatNumber(x) + ", graph 1 nohead dt 2 lw 2 lc rgb \"black\"\n";
+      }
+    }
+    // arrows outside the x range would be drawn over the next panel
+    figure.body += "  set xrange [0:" + FormatFixed(max_x * 1.05, 3) + "]\n";
+    std::string plot;
+    for (const auto& [index, tension] : blocks) {
+      plot += std::string(plot.empty() ? "  plot " : ", \\\n       ") + "\"figure7.dat\" index " +
+              std::to_string(index) + " using 1:2 with lines lw 2 title \"" + tension + "\"";
+    }
+    figure.body += plot + "\n";
+  }
+  figure.body += "  unset multiplot\n";
+  return figure;
+}
+
+// Runs `gnuplot -e "cd 'DIR'" NAME.gp`, its output into NAME.log (removed when empty).
+Status DrawFigure(const std::string& program, const fs::path& dir, const std::string& name) {
+  const std::string cd = "cd '" + dir.string() + "'";
+  const std::string script = (dir / (name + ".gp")).string();
+  const std::string log = (dir / (name + ".log")).string();
+  std::vector<std::string> arguments = {program, "-e", cd, script};
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) {
+    return NotFoundError(program + ": cannot run it (" + std::strerror(spawned) +
+                         "); install gnuplot (Debian: gnuplot-nox)");
+  }
+  int wait_status = 0;
+  if (waitpid(pid, &wait_status, 0) != pid || !WIFEXITED(wait_status) ||
+      WEXITSTATUS(wait_status) != 0) {
+    return IoError(program + " failed on " + script + "; its messages are in " + log);
+  }
+  std::error_code error;
+  if (fs::file_size(log, error) == 0) fs::remove(log, error);
+  return Status::Ok();
+}
+
+// Writes NAME.dat and NAME.gp, then draws NAME.png and NAME.svg. A write error is an
+// error; gnuplot missing or failing comes back as `drawn`.
+Status WriteFigure(const Figure& figure, const fs::path& dir, const std::string& gnuplot,
+                   Status& drawn) {
+  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / (figure.name + ".dat"), figure.data));
+  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / (figure.name + ".gp"), FigureScript(figure)));
+  if (drawn.ok()) drawn = DrawFigure(gnuplot, dir, figure.name);
+  return Status::Ok();
+}
+
+// ---------------------------------------------------------------------------------------
+// the report pages
+
+struct ReportContent {
+  const ReportCommand* command = nullptr;
+  const CampaignAnalysis* campaign = nullptr;
+  const std::vector<stats::TrialValue>* values = nullptr;
+  const stats::ResultsTable* table = nullptr;
+  const SimColumn* sim = nullptr;
+  std::vector<Figure> figures;
+  /// OK when gnuplot drew every figure.
+  Status drawn;
+};
+
+// "A1: 0.412 rad in [0.405, 0.419]" or the failure
+std::string TrialStatus(const sync::TrialOutcome& outcome) {
+  if (!outcome.status.ok()) return "failed: " + outcome.status.ToString();
+  const sync::LiftoffMeasurement& measured = *outcome.measurement;
+  return "ok: " + FormatFixed(measured.liftoff_rad, 3) + " rad in [" +
+         FormatFixed(measured.lower_rad, 3) + ", " + FormatFixed(measured.upper_rad, 3) + "]";
+}
+
+std::string SimDescription(const ReportContent& content) {
+  if (content.sim == nullptr) return "none (--no-sim)";
+  const SimColumn& sim = *content.sim;
+  return sim.results.model + ", " + Plural(static_cast<int64_t>(sim.results.runs.size()), "run") +
+         " (" + sim.results.description + "), cache " + sim.cache_path.string();
+}
+
+// provenance lines shared by both pages: (label, text)
+std::vector<std::pair<std::string, std::string>> Provenance(const ReportContent& content) {
+  const CampaignAnalysis& campaign = *content.campaign;
+  const int64_t trials = static_cast<int64_t>(campaign.analysis.outcomes.size());
+  return {{"manifest", content.command->manifest_path.string() + " (" + Plural(trials, "trial") +
+                           ", " + std::to_string(campaign.analysis.failed()) + " failed)"},
+          {"calibration", campaign.calibration.Brief()},
+          {"model", content.command->no_sim
+                        ? std::string("none")
+                        : ModelPathFrom(content.command->sweep.experiment).string()},
+          {"simulation", SimDescription(content)},
+          {"software", std::string("liftoff ") + kVersion}};
+}
+
+std::string ReportMarkdown(const ReportContent& content) {
+  std::string text = "# liftoff report\n\n";
+  for (const auto& [label, value] : Provenance(content)) text += "- " + label + ": " + value + "\n";
+  text += "\n## Table\n\n" + stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) +
+          "\n" +
+          stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown,
+                                  content.campaign->analysis.calibration, content.table->lookup_rule) +
+          "\n## Figures\n\n";
+  if (!content.drawn.ok()) text += "Not drawn: " + content.drawn.ToString() + "\n\n";
+  for (const Figure& figure : content.figures) {
+    if (content.drawn.ok()) text += "![" + figure.title + "](figures/" + figure.name + ".png)\n\n";
+    text += "Script [figures/" + figure.name + ".gp](figures/" + figure.name + ".gp), data [figures/" +
+            figure.name + ".dat](figures/" + figure.name + ".dat)\n\n";
+  }
+  text += "## Trials\n\n";
+  const auto& outcomes = content.campaign->analysis.outcomes;
+  for (size_t i = 0; i < outcomes.size(); ++i) {
+    text += "- " + outcomes[i].trial.id + " (foot " + std::string(FootName(outcomes[i].trial.foot)) +
+            "): " + TrialStatus(outcomes[i]) + "\n";
+    for (const std::string& note : content.campaign->notes[i]) text += "  - " + note + "\n";
+  }
+  return text;
+}
+
+std::string Base64(std::string_view bytes) {
+  static constexpr char kDigits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string encoded;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t group = static_cast<uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) group |= static_cast<uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8;
+    if (i + 2 < bytes.size()) group |= static_cast<uint32_t>(static_cast<unsigned char>(bytes[i + 2]));
+    encoded += kDigits[(group >> 18) & 63];
+    encoded += kDigits[(group >> 12) & 63];
+    encoded += i + 1 < bytes.size() ? kDigits[(group >> 6) & 63] : '=';
+    encoded += i + 2 < bytes.size() ? kDigits[group & 63] : '=';
+  }
+  return encoded;
+}
+
+std::string HtmlNumber(double value) {
+  return std::isfinite(value) ? FormatFixed(value, 3) : "&ndash;";
+}
+
+std::string HtmlTable(const stats::ResultsTable& table) {
+  std::string html =
+      "<table>\n<tr><th>Foot</th><th>Sim min</th><th>Sim max</th><th>HW n</th><th>HW min</th>"
+      "<th>HW max</th><th>HW mean</th><th>HW sd</th><th>95 % CI of the mean</th></tr>\n";
+  for (const stats::FootRow& row : table.rows) {
+    const stats::Summary& hw = row.hardware;
+    html += "<tr><td>" + std::string(FootName(row.foot)) + "</td><td>" +
+            (row.sim ? HtmlNumber(row.sim->min_rad) : "&ndash;") + "</td><td>" +
+            (row.sim ? HtmlNumber(row.sim->max_rad) : "&ndash;") + "</td><td>" +
+            std::to_string(hw.n) + "</td><td>" + HtmlNumber(hw.min) + "</td><td>" +
+            HtmlNumber(hw.max) + "</td><td>" + HtmlNumber(hw.mean) + "</td><td>" +
+            HtmlNumber(hw.stddev) + "</td><td>[" + HtmlNumber(hw.ci95_low) + ", " +
+            HtmlNumber(hw.ci95_high) + "]</td></tr>\n";
+  }
+  html += "</table>\n<p>" + EscapeMarkup(table.title) + ", rad; calibration " +
+          EscapeMarkup(table.calibration) + "; lookup " + EscapeMarkup(table.lookup_rule) + "</p>\n";
+  for (const std::string& note : table.notes) html += "<p>note: " + EscapeMarkup(note) + "</p>\n";
+  return html;
+}
+
+Result<std::string> ReportHtml(const ReportContent& content, const fs::path& figures_dir) {
+  std::string html =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<title>liftoff report</title>\n<style>body{font-family:sans-serif;max-width:1250px;"
+      "margin:auto}table{border-collapse:collapse}td,th{border:1px solid #999;padding:2px 8px;"
+      "text-align:right}img{max-width:100%}</style>\n</head>\n<body>\n<h1>liftoff report</h1>\n<ul>\n";
+  for (const auto& [label, value] : Provenance(content)) {
+    html += "<li>" + label + ": " + EscapeMarkup(value) + "</li>\n";
+  }
+  html += "</ul>\n<h2>Table</h2>\n" + HtmlTable(*content.table) + "<h2>Figures</h2>\n";
+  if (!content.drawn.ok()) html += "<p>Not drawn: " + EscapeMarkup(content.drawn.ToString()) + "</p>\n";
+  for (const Figure& figure : content.figures) {
+    if (!content.drawn.ok()) continue;
+    LIFTOFF_ASSIGN_OR_RETURN(const std::string png, ReadWholeFile(figures_dir / (figure.name + ".png")));
+    html += "<figure><img alt=\"" + EscapeMarkup(figure.title) + "\" src=\"data:image/png;base64," +
+            Base64(png) + "\"><figcaption>" + EscapeMarkup(figure.title) + "</figcaption></figure>\n";
+  }
+  html += "<h2>Trials</h2>\n<ul>\n";
+  const auto& outcomes = content.campaign->analysis.outcomes;
+  for (size_t i = 0; i < outcomes.size(); ++i) {
+    html += "<li>" + EscapeMarkup(outcomes[i].trial.id) + " (foot " +
+            std::string(FootName(outcomes[i].trial.foot)) + "): " +
+            EscapeMarkup(TrialStatus(outcomes[i]));
+    if (!content.campaign->notes[i].empty()) html += "<ul>";
+    for (const std::string& note : content.campaign->notes[i]) html += "<li>" + EscapeMarkup(note) + "</li>";
+    if (!content.campaign->notes[i].empty()) html += "</ul>";
+    html += "</li>\n";
+  }
+  return html + "</ul>\n</body>\n</html>\n";
+}
+
+// ---------------------------------------------------------------------------------------
+// writing it all
+
+Status WriteTables(const ReportContent& content, const fs::path& dir) {
+  const std::string& calibration = content.campaign->analysis.calibration;
+  const std::string& rule = content.table->lookup_rule;
+  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(
+      dir / "table.md",
+      stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) + "\n" +
+          stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown, calibration, rule)));
+  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(
+      dir / "table.csv", stats::RenderResultsTable(*content.table, stats::TableFormat::kCsv)));
+  return WriteFileAtomically(
+      dir / "trials.csv",
+      stats::RenderTrialTable(*content.values, stats::TableFormat::kCsv, calibration, rule));
+}
+
+Status WriteFiguresAndPages(ReportContent& content) {
+  const fs::path& dir = content.command->output_dir;
+  const fs::path figures_dir = dir / "figures";
+  content.figures.push_back(
+      TrialsFigure(*content.values, content.sim ? &content.sim->results : nullptr));
+  if (content.sim) {
+    if (auto figure7 = Figure7(content.sim->curves, *content.table)) {
+      content.figures.push_back(std::move(*figure7));
+    }
+  }
+  for (const Figure& figure : content.figures) {
+    LIFTOFF_RETURN_IF_ERROR(WriteFigure(figure, figures_dir, content.command->gnuplot, content.drawn));
+  }
+  LIFTOFF_RETURN_IF_ERROR(WriteTables(content, dir));
+  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / "report.md", ReportMarkdown(content)));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string html, ReportHtml(content, figures_dir));
+  return WriteFileAtomically(dir / "report.html", html);
+}
+
+// the terminal summary: one line per foot, then where the report is
+void PrintSummary(const ReportContent& content, std::ostream& out) {
+  const CampaignAnalysis& campaign = *content.campaign;
+  out << "report: " << Plural(static_cast<int64_t>(campaign.analysis.outcomes.size()), "trial")
+      << ", " << campaign.analysis.failed() << " failed; calibration "
+      << campaign.calibration.Brief() << "\n";
+  for (const stats::FootRow& row : content.table->rows) {
+    out << "  foot " << FootName(row.foot) << ": hardware " << row.hardware.Brief();
+    if (row.sim) {
+      out << "; simulation " << FormatFixed(row.sim->min_rad, 3) << " .. "
+          << FormatFixed(row.sim->max_rad, 3) << " rad";
+    }
+    out << "\n";
+  }
+  if (content.sim) {
+    out << "simulation: " << (content.sim->from_cache ? "from the cache " : "ran and cached in ")
+        << content.sim->cache_path.string() << "\n";
+  }
+  if (!content.drawn.ok()) {
+    out << "figures: not drawn (" << content.drawn.ToString()
+        << "); scripts and data are in " << (content.command->output_dir / "figures").string()
+        << "\n";
+  }
+  out << "wrote " << (content.command->output_dir / "report.html").string() << " and report.md\n";
+}
+
+}  // namespace
+
+int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err) {
+  if (command.output_dir.empty()) {
+    return ReportError(InvalidArgumentError("--output: name the report's folder"), err);
+  }
+  if (!command.no_sim) {
+    auto checked = SweepOptionsFrom(command.sweep);
+    if (!checked.ok()) return ReportError(checked.status(), err);
+  }
+
+  // the trials, as the table command analyses them
+  auto campaign = AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup,
+                                  command.sweep.experiment.progress, err);
+  if (!campaign.ok()) return ReportError(campaign.status(), err);
+  const Status outside = CheckInputsOutsideOutput(command, *campaign);
+  if (!outside.ok()) return ReportError(outside, err);
+
+  // the simulated column
+  std::optional<SimColumn> sim;
+  if (!command.no_sim) {
+    auto column = SimulatedColumn(command, campaign->calibration, err);
+    if (!column.ok()) return ReportError(column.status(), err);
+    sim = std::move(column).value();
+  }
+
+  // the table, the figures, the pages
+  const std::vector<stats::TrialValue> values = campaign->analysis.Values();
+  const stats::ResultsTable table = stats::BuildResultsTable(
+      values, sim ? &sim->results : nullptr, campaign->analysis.calibration,
+      std::string(sync::LookupRuleName(campaign->analysis.rule)));
+  ReportContent content;
+  content.command = &command;
+  content.campaign = &*campaign;
+  content.values = &values;
+  content.table = &table;
+  content.sim = sim ? &*sim : nullptr;
+  const Status written = WriteFiguresAndPages(content);
+  if (!written.ok()) return ReportError(written, err);
+  if (!content.drawn.ok()) err << "warning: figures: " << content.drawn.ToString() << '\n';
+  PrintSummary(content, out);
+
+  if (!campaign->first_failure.ok()) {
+    err << "liftoff: " << campaign->analysis.failed() << " of "
+        << campaign->analysis.outcomes.size() << " trials failed; the report holds the others\n";
+    return ExitCodeFor(campaign->first_failure.code());
+  }
+  return kExitOk;
+}
+
+}  // namespace liftoff::cli
