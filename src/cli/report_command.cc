@@ -58,24 +58,18 @@ Status CheckOutsideOutput(const fs::path& input, const fs::path& dir, std::strin
                               "; choose a folder without inputs (the report never overwrites one)");
 }
 
-// every file the report reads: manifest, calibration, logs, videos, model
+// every file the report reads: manifest, calibration, logs, videos (TrialInputs), model
 Status CheckInputsOutsideOutput(const ReportCommand& command, const CampaignAnalysis& campaign) {
-  const fs::path& dir = command.output_dir;
-  if (fs::is_regular_file(command.manifest_path)) {
-    LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(command.manifest_path, dir, "manifest"));
+  std::vector<NamedPath> inputs;
+  if (fs::is_regular_file(command.manifest_path)) inputs.push_back({"manifest", command.manifest_path});
+  for (NamedPath& input : TrialInputs(campaign.manifest)) inputs.push_back(std::move(input));
+  inputs.push_back({"calibration", campaign.calibration.source_path});
+  if (!command.no_sim) inputs.push_back({"model", ModelPathFrom(command.sweep.experiment)});
+  for (const NamedPath& input : inputs) {
+    if (input.path.empty()) continue;
+    LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(input.path, command.output_dir, input.role));
   }
-  fs::path calibration = command.calibration.calibration_path;
-  if (calibration.empty()) calibration = campaign.manifest.calibration_path.value_or(fs::path());
-  if (calibration.empty()) calibration = DefaultCalibrationPath();
-  LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(calibration, dir, "calibration"));
-  for (const TrialRecord& trial : campaign.manifest.trials) {
-    LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(trial.log_path, dir, "log of " + trial.id));
-    if (trial.video_path) {
-      LIFTOFF_RETURN_IF_ERROR(CheckOutsideOutput(*trial.video_path, dir, "video of " + trial.id));
-    }
-  }
-  if (command.no_sim) return Status::Ok();
-  return CheckOutsideOutput(ModelPathFrom(command.sweep.experiment), dir, "model");
+  return Status::Ok();
 }
 
 // ---------------------------------------------------------------------------------------

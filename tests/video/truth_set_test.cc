@@ -122,7 +122,7 @@ std::vector<ClipScore> ScoreFolder(const fs::path& root) {
 // `rotation_targets`, the rotation within 0.01 rad in every ok clip and within 0.005 rad in
 // at least 90 % of them. Returns the number of ok clips.
 size_t ExpectTargets(const std::vector<ClipScore>& scores, bool rotation_targets) {
-  size_t ok_clips = 0, within_5mrad = 0;
+  size_t ok_clips = 0, within_5mrad = 0, within_10mrad = 0;
   for (const ClipScore& s : scores) {
     if (!s.expect_ok) {
       EXPECT_EQ(s.status.code(), StatusCode::kNotFound) << s.id << ": " << s.status.ToString();
@@ -138,10 +138,7 @@ size_t ExpectTargets(const std::vector<ClipScore>& scores, bool rotation_targets
       EXPECT_LE(std::abs(s.rotation_error_rad), 0.01) << s.id;
     }
     if (std::abs(s.rotation_error_rad) <= 0.005) ++within_5mrad;
-  }
-  size_t within_10mrad = 0;
-  for (const ClipScore& s : scores) {
-    within_10mrad += s.expect_ok && s.status.ok() && std::abs(s.rotation_error_rad) <= 0.01;
+    if (std::abs(s.rotation_error_rad) <= 0.01) ++within_10mrad;
   }
   std::printf("%zu of %zu ok clips within 0.005 rad, %zu within 0.01 rad\n", within_5mrad,
               ok_clips, within_10mrad);
