@@ -118,6 +118,7 @@ struct VideoWriter::Impl {
   AVFrame* frame = nullptr;
   AVPacket* packet = nullptr;
   SwsContext* converter = nullptr;
+  cv::Mat padded;  // a picture of odd row length, copied for swscale (see Write)
   bool created = false;  // `partial_path` is ours
   bool closed = false;
   bool in_place = false;  // renamed onto `path`
@@ -346,8 +347,16 @@ Status VideoWriter::Write(const cv::Mat& bgr, int64_t pts_ns) {
   if (const int writable = av_frame_make_writable(impl.frame); writable < 0) {
     return impl.FailAv("cannot reuse the frame buffer", writable);
   }
-  const uint8_t* source_planes[1] = {bgr.data};
-  const int source_strides[1] = {static_cast<int>(bgr.step[0])};
+  // swscale's vector paths read rows in whole 16-byte blocks, past the end of a row whose
+  // length is not a multiple of 16: such a picture is read from a copy with a spare row
+  cv::Mat source = bgr;
+  if ((3 * bgr.cols) % 16 != 0) {
+    impl.padded.create(bgr.rows + 1, bgr.cols, CV_8UC3);
+    source = impl.padded(cv::Rect(0, 0, bgr.cols, bgr.rows));
+    bgr.copyTo(source);
+  }
+  const uint8_t* source_planes[1] = {source.data};
+  const int source_strides[1] = {static_cast<int>(source.step[0])};
   sws_scale(impl.converter, source_planes, source_strides, 0, bgr.rows, impl.frame->data,
             impl.frame->linesize);
   impl.frame->pts = tick;

@@ -50,6 +50,13 @@ class ClipPass {
   LedDetector& led() { return led_; }
   std::optional<FootTracker>& foot() { return foot_; }
 
+  // the parts of a frame the detectors read
+  std::vector<cv::Rect> RegionsRead(cv::Size frame_px) const {
+    std::vector<cv::Rect> regions = led_.RegionsRead(frame_px);
+    if (foot_) regions.push_back(foot_->RegionRead(frame_px));
+    return regions;
+  }
+
  private:
   const std::filesystem::path& path_;
   LedDetector led_;
@@ -443,6 +450,7 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
   FootTracker::Options foot_options = options.foot;
   if (reader.timing().lossless_codec) foot_options.compression_error_px = 0.0;
   ClipPass pass(options, foot_options, path);
+  reader.ConvertOnly(pass.RegionsRead(cv::Size(reader.width_px(), reader.height_px())));
   LIFTOFF_RETURN_IF_ERROR(RunPass(reader, pass, options.queue_frames, progress));
 
   ClipAnalysis analysis;

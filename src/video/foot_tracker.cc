@@ -242,13 +242,22 @@ struct FootTracker::Impl {
   cv::Rect2d PlacePatches(const PatchSelection& selection, FootTrack& track) const;
 };
 
-void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
-  const cv::Rect& roi = options.foot_roi_px;
+namespace {
+
+// the foot region with a margin around it, inside the frame
+cv::Rect WorkRegion(const cv::Rect& roi, const cv::Size& size) {
   const int margin_x = static_cast<int>(std::lround(kMarginFraction * roi.width));
   const int margin_y = static_cast<int>(std::lround(kMarginFraction * roi.height));
-  work_px = cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
-                     roi.height + 2 * margin_y) &
-            cv::Rect(0, 0, size.width, size.height);
+  return cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
+                  roi.height + 2 * margin_y) &
+         cv::Rect(0, 0, size.width, size.height);
+}
+
+}  // namespace
+
+void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
+  const cv::Rect& roi = options.foot_roi_px;
+  work_px = WorkRegion(roi, size);
   // never enlarged (enlarging a small region was measured worse)
   scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
   if (scale < 1) resizer = internal::AreaResizer(work_px.size(), scale);
@@ -429,6 +438,10 @@ FootTracker& FootTracker::operator=(FootTracker&&) noexcept = default;
 FootTracker::~FootTracker() = default;
 
 const std::vector<HeightSample>& FootTracker::samples() const { return impl_->samples; }
+
+cv::Rect FootTracker::RegionRead(cv::Size frame_px) const {
+  return WorkRegion(impl_->options.foot_roi_px, frame_px);
+}
 
 void FootTracker::SetRestWindow(int64_t rest_from_ns, int64_t rest_to_ns) {
   impl_->rest_from_ns = rest_from_ns;
@@ -805,7 +818,8 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                           const std::vector<double>& height, size_t first, double threshold_px,
                           double rest_noise_px, bool lossy) {
   LiftoffSearch search;
-  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
+  const size_t smooth_half = FramesIn(samples, kSmoothHalfS);
+  const std::vector<double> smooth = RunningMedian(height, smooth_half);
   for (size_t f = first; f < smooth.size(); ++f) {
     if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
   }
@@ -819,8 +833,9 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   }
   size_t cut_with_key = 0;
   // a key frame soon after the cut shows the foot without lag: fit up to it, unless the
-  // foot has gone far beyond the fit's top by then (a fast rise the model cannot follow)
-  for (size_t f = cut + 1; f < smooth.size(); ++f) {
+  // foot has gone far beyond the fit's top by then (a fast rise the model cannot follow;
+  // not known in the clip's last frames, where the running median sees only the past)
+  for (size_t f = cut + 1; f + smooth_half < smooth.size(); ++f) {
     if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
     if (!(smooth[f] <= kKeyframeReachTops * smooth[cut])) break;
     if (lossy && samples[f].keyframe && std::isfinite(height[f])) {

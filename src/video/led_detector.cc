@@ -1299,6 +1299,19 @@ LedDetector& LedDetector::operator=(LedDetector&&) noexcept = default;
 LedDetector::~LedDetector() = default;
 
 Status LedDetector::Process(const Frame& frame) { return impl_->Process(frame); }
+
+std::vector<cv::Rect> LedDetector::RegionsRead(cv::Size frame_px) const {
+  const cv::Rect whole(cv::Point(0, 0), frame_px);
+  const cv::Rect& roi = impl_->options.roi_px;
+  if (impl_->located || (roi & whole) != roi) return {whole};
+  // the ROI's rows across the frame (the ROI and its strips), and the reference cells' rows
+  std::vector<cv::Rect> regions = {cv::Rect(0, roi.y, frame_px.width, roi.height)};
+  const int cell_px = impl_->options.cell_px;
+  if (frame_px.width < cell_px || frame_px.height < cell_px) return {whole};
+  const Grid grid = Grid::Make(frame_px.width, frame_px.height, cell_px, kReferenceStride);
+  for (const int y0 : grid.y0_px) regions.emplace_back(0, y0, frame_px.width, cell_px);
+  return regions;
+}
 Result<LedResult> LedDetector::Finish() const { return impl_->Finish(); }
 
 }  // namespace liftoff::video

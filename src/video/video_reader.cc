@@ -18,11 +18,11 @@
 extern "C" {
 #include <libavutil/log.h>
 }
-#include <opencv2/videoio.hpp>
 
 #include "liftoff/core/file.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "av_decoder.h"
 #include "keyframes.h"
 #include "video_util.h"
 
@@ -39,12 +39,11 @@ struct DecoderLog {
 
 // FFmpeg prints demuxer and decoder complaints about damaged files straight to stderr,
 // many per file. liftoff reports damage through its own errors, so while any reader is
-// inside OpenCV, FFmpeg's messages are caught instead of printed: those logged on the
+// decoding, FFmpeg's messages are caught instead of printed: those logged on the
 // reader's thread (the demuxer's) are counted and the first kept for the message; those
 // of the decoder's worker threads are dropped. Otherwise messages go to FFmpeg's own
-// printer as before. OpenCV resets FFmpeg's level at every open, not its printer, so the
-// printer is the place to filter (the same libavutil OpenCV's videoio loads: Debian
-// builds both against the system FFmpeg).
+// printer as before. OpenCV (whose writer liftoff uses) resets FFmpeg's level at every
+// open, not its printer, so the printer is the place to filter.
 using AvLogCallback = void (*)(void*, int, const char*, va_list);
 std::atomic<int> g_readers_inside{0};
 thread_local DecoderLog* t_decoder_log = nullptr;
@@ -82,8 +81,7 @@ void InstallDecoderLogFilter() {
   static_cast<void>(installed);
 }
 
-// While alive, FFmpeg's messages on this thread go to `log`, and OpenCV's own log (which
-// reports failed opens as errors) is silenced.
+// While alive, FFmpeg's messages on this thread go to `log`.
 class CatchDecoderLog {
  public:
   explicit CatchDecoderLog(DecoderLog& log) : previous_(t_decoder_log) {
@@ -99,25 +97,8 @@ class CatchDecoderLog {
   CatchDecoderLog& operator=(const CatchDecoderLog&) = delete;
 
  private:
-  internal::QuietOpenCvLog quiet_;
   DecoderLog* previous_;
 };
-
-// Whether the file starts like a container liftoff expects a camera video in: an MP4 /
-// QuickTime box, Matroska's EBML magic or a RIFF AVI header.
-// the four characters of a FourCC code; empty when unknown or not printable
-std::string FourccText(double code) {
-  if (!std::isfinite(code) || code <= 0 || code > 4294967295.0) return {};
-  const auto value = static_cast<uint32_t>(code);
-  std::string text;
-  for (int i = 0; i < 4; ++i) {
-    const auto c = static_cast<char>((value >> (8 * i)) & 0xFFu);
-    if (c == '\0') break;
-    if (c < ' ' || c > '~') return {};
-    text.push_back(c);
-  }
-  return text;
-}
 
 // codecs that keep every pixel: FFV1, HuffYUV, UtVideo, PNG, raw pictures (unknown: lossy)
 bool IsLosslessCodec(std::string fourcc) {
@@ -149,6 +130,8 @@ class FileHead {
   size_t size_ = 0;
 };
 
+// Whether the file starts like a container liftoff expects a camera video in: an MP4 /
+// QuickTime box, Matroska's EBML magic or a RIFF AVI header.
 bool LooksLikeVideoContainer(const fs::path& path) {
   const FileHead head(path);
   const auto has = [&](size_t offset, std::string_view text) { return head.Has(offset, text); };
@@ -252,8 +235,10 @@ struct VideoReader::Impl {
   fs::path path;
   std::string name;  // the file as messages show it
   Options options;
-  cv::VideoCapture capture;
+  std::unique_ptr<internal::AvDecoder> decoder;
   int width_px = 0, height_px = 0;
+  // the regions of each frame converted to BGR (empty: the whole picture)
+  std::vector<cv::Rect> regions_px;
 
   // frame 0, decoded by Open to tell a video from a damaged file
   cv::Mat first_bgr;
@@ -424,29 +409,27 @@ Result<VideoReader> VideoReader::Open(const fs::path& path, const Options& optio
                      : ParseError(impl->name + ": not a video (" + why + ")");
   };
 
-  try {
+  {
     CatchDecoderLog catching(impl->decoder_log);
-    if (!impl->capture.open(path.string(), cv::CAP_FFMPEG)) {
-      return damaged("no decoder could open it" + impl->FfmpegSays());
+    Result<std::unique_ptr<internal::AvDecoder>> decoder =
+        internal::AvDecoder::Open(path.string());
+    if (!decoder.ok()) {
+      return damaged("no decoder could open it (" + decoder.status().message() + ")" +
+                     impl->FfmpegSays());
     }
-    impl->report.container_fps = impl->capture.get(cv::CAP_PROP_FPS);
-    impl->report.codec_fourcc = FourccText(impl->capture.get(cv::CAP_PROP_FOURCC));
+    impl->decoder = std::move(decoder).value();
+    const internal::StreamFacts& facts = impl->decoder->facts();
+    impl->report.container_fps = facts.fps;
+    impl->report.codec_fourcc = facts.fourcc;
     impl->report.lossless_codec = IsLosslessCodec(impl->report.codec_fourcc);
-    const double listed = impl->capture.get(cv::CAP_PROP_FRAME_COUNT);
-    impl->report.container_frames =
-        std::isfinite(listed) && listed > 0 ? static_cast<int64_t>(std::llround(listed)) : 0;
-    if (!impl->capture.read(impl->first_bgr) || impl->first_bgr.empty()) {
+    impl->report.container_frames = facts.frames;
+    if (!impl->decoder->Next()) {
       return damaged("no frame could be decoded" + impl->FfmpegSays());
     }
-    impl->first_ms = impl->capture.get(cv::CAP_PROP_POS_MSEC);
-  } catch (const cv::Exception& exception) {
-    return damaged(std::string("OpenCV: ") + exception.what());
+    impl->decoder->ToBgr({}, impl->first_bgr);
+    impl->first_ms = impl->decoder->position_ms();
   }
-  if (impl->first_bgr.type() != CV_8UC3) {
-    return UnsupportedError(impl->name + ": decodes to " +
-                            std::to_string(impl->first_bgr.channels()) +
-                            "-channel pictures; expected 8-bit BGR");
-  }
+  if (impl->first_bgr.empty()) return damaged("no frame could be decoded" + impl->FfmpegSays());
   impl->width_px = impl->first_bgr.cols;
   impl->height_px = impl->first_bgr.rows;
   {
@@ -476,19 +459,17 @@ Result<bool> VideoReader::Next(Frame& frame) {
     position_ms = impl.first_ms;
   } else {
     bool decoded = false;
-    try {
+    {
       CatchDecoderLog catching(impl.decoder_log);
-      decoded = impl.capture.read(frame.bgr) && !frame.bgr.empty();
-      if (decoded) position_ms = impl.capture.get(cv::CAP_PROP_POS_MSEC);
-    } catch (const cv::Exception& exception) {
-      impl.ended = true;
-      impl.FinishReport();
-      return ParseError(impl.name + ": truncated or damaged: OpenCV failed after frame " +
-                        std::to_string(impl.next_index - 1) + ": " + exception.what());
+      decoded = impl.decoder->Next();
+      if (decoded) {
+        impl.decoder->ToBgr(impl.regions_px, frame.bgr);
+        position_ms = impl.decoder->position_ms();
+      }
     }
     if (!decoded) {
       impl.ended = true;
-      impl.capture.release();
+      impl.decoder.reset();
       impl.FinishReport();
       LIFTOFF_RETURN_IF_ERROR(impl.CheckEnd());
       return false;
@@ -505,13 +486,17 @@ Result<bool> VideoReader::Next(Frame& frame) {
   frame.index = impl.next_index++;
   frame.t_ns = impl.TimeOf(frame.index, position_ms, repaired);
   frame.t_repaired = repaired;
-  // a key frame by its time (within a tenth of a millisecond: OpenCV's times are the
+  // a key frame by its time (within a tenth of a millisecond: the decoder's times are the
   // same packets' times in ms); unknown: every frame is one
   frame.keyframe = !impl.report.keyframes_known ||
                    (!repaired && internal::NearAny(impl.keyframe_times_ns, frame.t_ns, 100000));
   if (frame.keyframe) ++impl.report.keyframes;
   impl.Record(frame.index, frame.t_ns, repaired);
   return true;
+}
+
+void VideoReader::ConvertOnly(std::vector<cv::Rect> regions_px) {
+  impl_->regions_px = std::move(regions_px);
 }
 
 int VideoReader::width_px() const { return impl_->width_px; }

@@ -7,9 +7,9 @@
 // Containers, codecs and what they store:
 //   h264   libx264 in MP4 (yuv420p, preset veryfast, crf = quality, 2 B-frames always,
 //          moov atom up front). Track time base 1/time_base_den: by default exact to 1 us.
-//          The B-frames are on purpose: OpenCV's FFmpeg backend (4.6) reads
-//          CAP_PROP_POS_MSEC 0 for the frames drained from the decoder at the end of the
-//          file (the last 2 here), which the video pipeline must repair.
+//          The B-frames are on purpose: frames come out of the decoder in another
+//          order than their packets, and the last 2 only when it is drained at the end
+//          (OpenCV's FFmpeg backend 4.6 reads 0 ms for those; liftoff's reader does not).
 //   mjpeg  Motion JPEG in AVI (full-range 4:2:0, q:v = quality). AVI counts frame slots
 //          of 1/nominal_fps: each timestamp is stored rounded to the nearest slot. Dropped
 //          slots survive (the muxer writes empty chunks, which readers skip, so later
@@ -17,8 +17,8 @@
 //          jitter below half a slot does not.
 //   ffv1   lossless FFV1 in Matroska (packed bgr0: decodes to the input pixels exactly).
 //          FFmpeg's Matroska muxer stores milliseconds: timestamps round to 1 ms.
-// Readers count time from the first frame (OpenCV's CAP_PROP_POS_MSEC subtracts the
-// stream's start; AVI stores the first frame at slot 0 whatever its time), so the first
+// Readers count time from the first frame (liftoff's reader and OpenCV's CAP_PROP_POS_MSEC
+// subtract the stream's start; AVI stores the first frame at slot 0 whatever its time), so the first
 // frame must be stored at 0: then reader times and StoredPtsNs() agree.
 // Output is bit-exact: the same options and frames give the same bytes.
 #pragma once

@@ -185,6 +185,9 @@ class FootTracker {
   /// increase. The first 4 frames make the templates; every frame after registers the
   /// patches (bench/video_bench prints the cost).
   Status Process(const Frame& frame);
+  /// The part of a `frame_px` frame that Process reads: the foot region with a margin
+  /// around it. A reader need convert only this (VideoReader::ConvertOnly).
+  cv::Rect RegionRead(cv::Size frame_px) const;
   /// Sets the rest window after the fact (the LED instant is known only at the end of a
   /// single pass); overrides Options::rest_from_ns/rest_to_ns.
   void SetRestWindow(int64_t rest_from_ns, int64_t rest_to_ns);

@@ -15,8 +15,8 @@ struct Frame {
   /// Presentation time, video clock, ns from the stream's start (the first frame of a
   /// camera file is at or near 0). Strictly increasing across frames.
   int64_t t_ns = 0;
-  /// True when t_ns was not read from the file but repaired (the FFmpeg backend reports
-  /// 0 ms for the last frames of H.264 with B-frames; those are extrapolated).
+  /// True when t_ns was not read from the file but repaired: a frame without a time, or
+  /// whose time does not increase, is given the previous time plus the usual interval.
   bool t_repaired = false;
   /// The picture, CV_8UC3 BGR. Valid until the reader decodes the next frame: detectors
   /// that keep pixels must copy them.

@@ -1,9 +1,9 @@
-// Sequential decoding with true per-frame timestamps. Nominal frame rate and the
-// container's frame count are never trusted (both lie for variable-frame-rate files):
-// each frame's time is read from the decoder (OpenCV's FFmpeg backend, CAP_PROP_POS_MSEC)
-// and checked. Known quirk repaired: the last frames of H.264 with B-frames read 0 ms;
-// they (and any time that does not increase) are extrapolated from the median interval
-// and marked (Frame::t_repaired). Dropped and irregular frames are reported in
+// Sequential decoding with true per-frame timestamps, through FFmpeg's libraries (decoded
+// and converted to BGR as OpenCV's FFmpeg backend does, whose times and container figures
+// it also reports). Nominal frame rate and the container's frame count are never trusted
+// (both lie for variable-frame-rate files): each frame's time is the decoder's
+// presentation time, checked; a time that is missing or does not increase is extrapolated
+// from the median interval and marked (Frame::t_repaired). Dropped and irregular frames are reported in
 // FrameTimingReport. Memory stays flat: one frame buffer, a few dozen intervals and a
 // fixed histogram.
 #pragma once
@@ -112,6 +112,12 @@ class VideoReader {
   /// stay valid. FFmpeg's and OpenCV's own messages are caught while the reader works
   /// (the first error goes into the message and FrameTimingReport), never printed.
   Result<bool> Next(Frame& frame);
+
+  /// From the next frame on, converts only these regions of each picture to BGR (at least
+  /// their pixels, equal to a whole conversion's); the rest of Frame::bgr is unspecified.
+  /// Empty (the default): whole pictures. Converting a picture to BGR costs more than
+  /// decoding it at 720p, and a detector reads a few regions.
+  void ConvertOnly(std::vector<cv::Rect> regions_px);
 
   /// Image size, px.
   int width_px() const;
