@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "liftoff/capture/csv_log.h"
 #include "liftoff/capture/laika2018.h"
 
 namespace liftoff::capture {
@@ -28,6 +29,11 @@ void FillDerivedAngles(LogSample& sample, const Calibration& calibration) {
 Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFormat format,
                                         const Calibration& calibration,
                                         const LogReadOptions& options) {
+  if (format == LogFormat::kCsv) {
+    return InvalidArgumentError(path.string() +
+                                ": a CSV log is read through a manifest that names its columns "
+                                "(docs/formats.md, CSV logs)");
+  }
   Result<ControllerLog> log = format == LogFormat::kLaika2018
                                   ? ImportLaika2018Log(path, calibration, options)
                                   : ReadControllerLog(path, options);
@@ -35,6 +41,21 @@ Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFo
   if (format == LogFormat::kLiftoff) {
     for (LogSample& sample : log->samples) FillDerivedAngles(sample, calibration);
   }
+  return log;
+}
+
+Result<ControllerLog> LoadTrialLog(const TrialRecord& trial, const Calibration& calibration,
+                                   const LogReadOptions& options) {
+  if (trial.log_format != LogFormat::kCsv) {
+    return LoadControllerLog(trial.log_path, trial.log_format, calibration, options);
+  }
+  if (!trial.log_columns) {
+    return InvalidArgumentError("trial " + trial.id + ": a CSV log needs its columns");
+  }
+  Result<ControllerLog> log = ReadCsvLog(trial.log_path, *trial.log_columns, options);
+  if (!log.ok()) return log.status();
+  log->header.calibration = calibration.name;
+  for (LogSample& sample : log->samples) FillDerivedAngles(sample, calibration);
   return log;
 }
 

@@ -1,6 +1,7 @@
 #include "liftoff/core/manifest.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -54,6 +55,29 @@ std::string WritePath(const fs::path& path, const fs::path& base_dir) {
   if (std::distance(normal.begin(), in_path) < 2 || relative.empty())
     return normal.generic_string();
   return relative.generic_string();
+}
+
+// The columns of a "csv" log, beside its path and format.
+CsvLogColumns ReadCsvColumns(JsonReader& log) {
+  CsvLogColumns columns;
+  columns.time_column = log.String("time_column");
+  if (auto unit = log.OptionalEnum("time_unit", {"s", "ms", "us", "ns"})) {
+    columns.time_unit = std::array{"s", "ms", "us", "ns"}[*unit];
+  }
+  columns.angle_column = log.String("angle_column");
+  if (auto unit = log.OptionalEnum("angle_unit", {"rad", "deg", "counts"})) {
+    columns.angle_unit = std::array{"rad", "deg", "counts"}[*unit];
+  }
+  columns.led_column = log.OptionalString("led_column");
+  columns.led_on_s = log.OptionalNumber("led_on_s", {.min = -kMaxTimeSeconds, .max = kMaxTimeSeconds});
+  for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"time_column", &columns.time_column},
+                                  {"angle_column", &columns.angle_column}}) {
+    if (!log.failed() && name->empty()) log.Fail(key, "expected a column name");
+  }
+  if (!log.failed() && columns.led_column && columns.led_on_s) {
+    log.Fail("led_on_s", "expected either led_column or led_on_s, not both");
+  }
+  return columns;
 }
 
 // [x, y, width, height] in whole pixels, the rectangle inside the first quadrant.
@@ -127,9 +151,11 @@ TrialRecord ReadTrial(JsonReader& reader, const fs::path& base_dir) {
   JsonReader log = reader.Object("log");
   trial.log_path = ReadPath(log, "path", base_dir, true).value_or(fs::path());
   if (auto format = log.OptionalEnum(
-          "format", {LogFormatName(LogFormat::kLiftoff), LogFormatName(LogFormat::kLaika2018)})) {
+          "format", {LogFormatName(LogFormat::kLiftoff), LogFormatName(LogFormat::kLaika2018),
+                     LogFormatName(LogFormat::kCsv)})) {
     trial.log_format = static_cast<LogFormat>(*format);
   }
+  if (trial.log_format == LogFormat::kCsv) trial.log_columns = ReadCsvColumns(log);
   if (std::optional<JsonReader> video = reader.OptionalObject("video")) {
     trial.video_path = ReadPath(*video, "path", base_dir, true);
     trial.px_per_mm = video->OptionalNumber("px_per_mm", kPxPerMmRange);
@@ -155,11 +181,16 @@ json RegionToJson(const RegionPx& region) {
 }  // namespace
 
 std::string_view LogFormatName(LogFormat format) {
-  return format == LogFormat::kLaika2018 ? "laika-2018" : "liftoff";
+  switch (format) {
+    case LogFormat::kLaika2018: return "laika-2018";
+    case LogFormat::kCsv: return "csv";
+    case LogFormat::kLiftoff: break;
+  }
+  return "liftoff";
 }
 
 std::optional<LogFormat> ParseLogFormat(std::string_view text) {
-  for (LogFormat format : {LogFormat::kLiftoff, LogFormat::kLaika2018}) {
+  for (LogFormat format : {LogFormat::kLiftoff, LogFormat::kLaika2018, LogFormat::kCsv}) {
     if (text == LogFormatName(format)) return format;
   }
   return std::nullopt;
@@ -182,6 +213,9 @@ Status ValidateTrials(const std::vector<TrialRecord>& trials, const std::string&
                                   trial.id + "\"");
     }
     if (trial.log_path.empty()) return InvalidArgumentError(where + ": expected a log path");
+    if ((trial.log_format == LogFormat::kCsv) != trial.log_columns.has_value()) {
+      return InvalidArgumentError(where + ": log: expected columns for a csv log, and only for one");
+    }
     if (trial.test_number && *trial.test_number < 1) {
       return InvalidArgumentError(where + ": test number: expected an integer >= 1, got " +
                                   std::to_string(*trial.test_number));
@@ -271,6 +305,15 @@ json ManifestToJson(const TrialManifest& manifest, const fs::path& base_dir) {
     if (trial.rotation) entry["rotation"] = RotationSenseName(*trial.rotation);
     entry["log"] = {{"path", WritePath(trial.log_path, base)},
                     {"format", LogFormatName(trial.log_format)}};
+    if (trial.log_columns) {
+      const CsvLogColumns& columns = *trial.log_columns;
+      entry["log"]["time_column"] = columns.time_column;
+      entry["log"]["time_unit"] = columns.time_unit;
+      entry["log"]["angle_column"] = columns.angle_column;
+      entry["log"]["angle_unit"] = columns.angle_unit;
+      if (columns.led_column) entry["log"]["led_column"] = *columns.led_column;
+      if (columns.led_on_s) entry["log"]["led_on_s"] = *columns.led_on_s;
+    }
     if (trial.video_path) {
       entry["video"] = {{"path", WritePath(*trial.video_path, base)}};
       if (trial.px_per_mm) entry["video"]["px_per_mm"] = *trial.px_per_mm;

@@ -62,7 +62,7 @@ Status AnalyzeTrial(const TrialManifest& manifest, const Calibration& calibratio
 
   // the log (its errors name it), then the angle at liftoff on it (they do not)
   Result<ControllerLog> log =
-      capture::LoadControllerLog(trial.log_path, trial.log_format, calibration, options.log);
+      capture::LoadTrialLog(trial, calibration, options.log);
   if (!log.ok()) return ForTrial(log.status(), trial);
   outcome.log_report = log->report;
   Result<LiftoffMeasurement> measurement = MeasureLiftoff(*log, times, options.lookup);

@@ -16,8 +16,14 @@ namespace liftoff::capture {
 /// rotate_shaft_rad from rotate_counts, vertebra_rad from rotate_shaft_rad, bend_spool_rad
 /// from bend_counts; angles present in the file are kept. Errors are the reader's, and
 /// always name the file.
+/// A LogFormat::kCsv log needs its columns: kInvalidArgument (read it with LoadTrialLog).
 Result<ControllerLog> LoadControllerLog(const std::filesystem::path& path, LogFormat format,
                                         const Calibration& calibration,
                                         const LogReadOptions& options = {});
+
+/// A manifest trial's log: LoadControllerLog with the trial's format, or ReadCsvLog with
+/// its columns (angles filled in the same way).
+Result<ControllerLog> LoadTrialLog(const TrialRecord& trial, const Calibration& calibration,
+                                   const LogReadOptions& options = {});
 
 }  // namespace liftoff::capture

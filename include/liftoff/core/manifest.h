@@ -21,9 +21,29 @@ namespace liftoff {
 enum class LogFormat {
   kLiftoff,    ///< liftoff's own log (docs/formats.md)
   kLaika2018,  ///< the 2018 Laika serial dump: `t_ms,value,` lines, CR line ends
+  kCsv,        ///< a user's own logger: a CSV file with named columns (CsvLogColumns)
 };
 
-/// "liftoff", "laika-2018".
+/// How a plain CSV log (LogFormat::kCsv) is read: its first line names the columns, then
+/// one sample a line; other columns are ignored. The `controller.csv` files of liftoff's
+/// video development set are one such log: time "t_ms" in "ms", angle "rotation_rad" in
+/// "rad", the LED switching on at time 0.
+struct CsvLogColumns {
+  /// The controller clock's column and its unit: "s", "ms", "us" or "ns".
+  std::string time_column;
+  std::string time_unit = "s";
+  /// The rotating vertebra's column and its unit: "rad" or "deg" (the vertebra's angle),
+  /// or "counts" (the rotating motor's encoder counts, turned into the vertebra's angle
+  /// through the calibration).
+  std::string angle_column;
+  std::string angle_unit = "rad";
+  /// Where the LED switch-on is: a column of the LED's state (0 or 1; its first rise), or
+  /// its time on the log's clock, s. Neither: the log's origin, with a warning.
+  std::optional<std::string> led_column;
+  std::optional<double> led_on_s;
+};
+
+/// "liftoff", "laika-2018", "csv".
 std::string_view LogFormatName(LogFormat format);
 std::optional<LogFormat> ParseLogFormat(std::string_view text);
 
@@ -63,6 +83,8 @@ struct TrialRecord {
   /// Controller log, absolute (resolved against the manifest's folder when loaded).
   std::filesystem::path log_path;
   LogFormat log_format = LogFormat::kLiftoff;
+  /// The columns of a LogFormat::kCsv log (required for it, absent otherwise).
+  std::optional<CsvLogColumns> log_columns;
   /// Video of the trial, absolute, when there is one.
   std::optional<std::filesystem::path> video_path;
   /// Image scale at the foot, px per mm of vertical motion, when known (a liftoff
