@@ -1,6 +1,7 @@
 #include "report_calibration.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -105,9 +106,15 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
         << " and " << Plural(static_cast<int64_t>(draws.size()), "Monte Carlo draw") << ", each for "
         << sweep.feet.size() << (sweep.feet.size() == 1 ? " foot" : " feet") << "\n";
   }
+  const auto start = std::chrono::steady_clock::now();
   LIFTOFF_ASSIGN_OR_RETURN(result.grid, fit::SimulateTensions(model, sweep, grid));
   if (!draws.empty()) {
     LIFTOFF_ASSIGN_OR_RETURN(result.monte_carlo, fit::SimulateTensions(model, sweep, draws));
+  }
+  if (command.sweep.experiment.progress != "off") {
+    const std::chrono::duration<double> wall = std::chrono::steady_clock::now() - start;
+    err << "calibration: " << (grid.size() + draws.size()) * sweep.feet.size() << " runs in "
+        << FormatFixed(wall.count(), 2) << " s wall\n";
   }
   const json document = {{"format", kCacheFormat},
                          {"version", kCacheVersion},
@@ -171,6 +178,12 @@ std::string RankingMarkdown(const ReportCalibration& calibration, const std::str
             (point.complete ? FormatFixed(point.chi_square, 1) : "incomplete") + " |";
     for (const fit::FootAgreement& foot : point.feet) text += " " + ZText(foot) + " |";
     text += "\n";
+  }
+  const std::vector<TensionPoint>& points = calibration.tension_points;
+  for (size_t i = 0; i < ranking.overall.size() && !points.empty(); ++i) {
+    if (ranking.overall[i].tension.name != points.back().name) continue;
+    text += "\nThe highest tension point, " + points.back().name + ", ranks " + std::to_string(i + 1) +
+            " of " + std::to_string(ranking.overall.size()) + ".\n";
   }
   text += "\nPer foot, best first (by |z|):\n\n";
   for (const auto& [foot, names] : ranking.per_foot) {
@@ -307,6 +320,7 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
   result.command = &command;
   result.cache_path = cache_path;
   result.fitted = calibration;
+  result.tension_points = calibration.tension_points;
 
   // the simulated runs: grid and Monte Carlo
   LIFTOFF_ASSIGN_OR_RETURN(const sim::ModelDescription model,

@@ -23,6 +23,8 @@ namespace liftoff::cli {
 struct ReportCalibration {
   /// The command it was made for (its fit and Monte Carlo options are reported).
   const ReportCommand* command = nullptr;
+  /// The campaign calibration's tension points, low to high.
+  std::vector<TensionPoint> tension_points;
   /// The hardware per foot, and the feet left out (fewer than two trials).
   std::vector<fit::FootTarget> targets;
   std::vector<std::string> skipped;
