@@ -98,13 +98,15 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
     result.from_cache = true;
     return Status::Ok();
   }
-  const std::vector<TensionPoint> grid = fit::GridTensionPoints(calibration.tension_points, command.fit);
+  const std::vector<TensionPoint> grid =
+      fit::GridTensionPoints(calibration.tension_points, command.fit);
   LIFTOFF_ASSIGN_OR_RETURN(const std::vector<TensionPoint> draws,
                            fit::MonteCarloDraws(calibration, command.monte_carlo));
   if (command.sweep.experiment.progress != "off") {
     err << "calibration: simulating " << Plural(static_cast<int64_t>(grid.size()), "tension scale")
-        << " and " << Plural(static_cast<int64_t>(draws.size()), "Monte Carlo draw") << ", each for "
-        << sweep.feet.size() << (sweep.feet.size() == 1 ? " foot" : " feet") << "\n";
+        << " and " << Plural(static_cast<int64_t>(draws.size()), "Monte Carlo draw")
+        << ", each for " << sweep.feet.size() << (sweep.feet.size() == 1 ? " foot" : " feet")
+        << "\n";
   }
   const auto start = std::chrono::steady_clock::now();
   LIFTOFF_ASSIGN_OR_RETURN(result.grid, fit::SimulateTensions(model, sweep, grid));
@@ -132,7 +134,8 @@ Calibration FittedCalibration(const Calibration& calibration, const fit::Tension
   Calibration result = calibration;
   result.source_path.clear();
   result.name = calibration.name + "-fitted";
-  result.description = calibration.description + "; tension scale fitted by liftoff report on " + campaign;
+  result.description =
+      calibration.description + "; tension scale fitted by liftoff report on " + campaign;
   std::vector<TensionPoint>& points = result.tension_points;
   points.erase(std::remove_if(points.begin(), points.end(),
                               [](const TensionPoint& point) { return point.name == "fitted"; }),
@@ -144,7 +147,8 @@ Calibration FittedCalibration(const Calibration& calibration, const fit::Tension
   const size_t index = static_cast<size_t>(at - points.begin());
   if (!on_a_point) points.insert(at, fitted.tension);
   for (auto note = result.notes.begin(); note != result.notes.end();) {
-    note = note->first.rfind("/tension_points/", 0) == 0 ? result.notes.erase(note) : std::next(note);
+    note =
+        note->first.rfind("/tension_points/", 0) == 0 ? result.notes.erase(note) : std::next(note);
   }
   result.notes["/tension_points/" + std::to_string(index)] =
       std::string(on_a_point ? "the tension scale fitted by liftoff report to " + campaign +
@@ -182,8 +186,8 @@ std::string RankingMarkdown(const ReportCalibration& calibration, const std::str
   const std::vector<TensionPoint>& points = calibration.tension_points;
   for (size_t i = 0; i < ranking.overall.size() && !points.empty(); ++i) {
     if (ranking.overall[i].tension.name != points.back().name) continue;
-    text += "\nThe highest tension point, " + points.back().name + ", ranks " + std::to_string(i + 1) +
-            " of " + std::to_string(ranking.overall.size()) + ".\n";
+    text += "\nThe highest tension point, " + points.back().name + ", ranks " +
+            std::to_string(i + 1) + " of " + std::to_string(ranking.overall.size()) + ".\n";
   }
   text += "\nPer foot, best first (by |z|):\n\n";
   for (const auto& [foot, names] : ranking.per_foot) {
@@ -219,8 +223,9 @@ std::string FitMarkdown(const ReportCalibration& calibration, const ReportComman
           Signed(fitted.searched_sigma_max, 2) + " (simulated every " +
           FormatNumber(command.fit.sigma_step) +
           "; between those points the liftoff rotation is interpolated linearly)\n\n";
-  text += "| foot | trials | hardware mean | standard error | sim at the fit (interpolated) | "
-          "sim at the fit (run) | z |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  text +=
+      "| foot | trials | hardware mean | standard error | sim at the fit (interpolated) | "
+      "sim at the fit (run) | z |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (size_t f = 0; f < fitted.feet.size(); ++f) {
     const fit::FootTarget& target = calibration.targets[f];
     const double run = AtFitRad(calibration, target.foot);
@@ -349,7 +354,8 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
     return result;
   }
   result.ranking = fit::RankTensionPoints(result.targets, SweepSamples(sim, calibration));
-  auto fitted = fit::FitTension(result.targets, result.grid, calibration.tension_points, command.fit);
+  auto fitted =
+      fit::FitTension(result.targets, result.grid, calibration.tension_points, command.fit);
   if (!fitted.ok()) {
     result.fit_status = fitted.status();
     return result;
@@ -380,10 +386,12 @@ std::optional<ReportFigure> FitFigure(const ReportCalibration& calibration) {
     const fit::FootTarget& target = calibration.targets[f];
     const std::string foot(FootName(target.foot));
     const std::string colour = std::to_string(FootIndex(target.foot) + 1);
-    figure.data += "# block " + std::to_string(block) + ": foot " + foot + ", simulated: sigma liftoff_rad\n";
+    figure.data +=
+        "# block " + std::to_string(block) + ": foot " + foot + ", simulated: sigma liftoff_rad\n";
     for (const fit::TensionSample& sample : calibration.grid) {
       const std::optional<double>& value = sample.liftoff_rad[FootIndex(target.foot)];
-      if (value) figure.data += FormatNumber(sample.tension.sigma) + " " + FormatNumber(*value) + "\n";
+      if (value)
+        figure.data += FormatNumber(sample.tension.sigma) + " " + FormatNumber(*value) + "\n";
     }
     figure.data += "\n\n# block " + std::to_string(block + 1) + ": foot " + foot +
                    ", hardware mean: sigma liftoff_rad\n" + FormatNumber(low) + " " +
@@ -391,8 +399,9 @@ std::optional<ReportFigure> FitFigure(const ReportCalibration& calibration) {
                    FormatNumber(target.summary.mean) + "\n\n\n";
     plot += std::string(plot.empty() ? "  plot " : ", \\\n       ") + "\"fit.dat\" index " +
             std::to_string(block) + " using 1:2 with linespoints lw 2 pt 7 ps 0.6 lc " + colour +
-            " title \"" + foot + " simulated\", \\\n       \"\" index " + std::to_string(block + 1) +
-            " using 1:2 with lines dt 2 lw 2 lc " + colour + " title \"" + foot + " hardware mean\"";
+            " title \"" + foot + " simulated\", \\\n       \"\" index " +
+            std::to_string(block + 1) + " using 1:2 with lines dt 2 lw 2 lc " + colour +
+            " title \"" + foot + " hardware mean\"";
     block += 2;
   }
   figure.body =
@@ -419,13 +428,16 @@ std::optional<ReportFigure> FitFigure(const ReportCalibration& calibration) {
 // simulation at the fit
 std::optional<ReportFigure> MonteCarloFigure(const ReportCalibration& calibration) {
   if (calibration.targets.empty() && calibration.distributions.empty()) return std::nullopt;
-  ReportFigure figure{"montecarlo",
-                      "per foot: hardware trials and range beside the Monte Carlo's simulated values",
-                      "", ""};
-  auto x = [](Foot foot, double offset) { return FormatNumber(static_cast<double>(FootIndex(foot)) + 1.0 + offset); };
+  ReportFigure figure{
+      "montecarlo", "per foot: hardware trials and range beside the Monte Carlo's simulated values",
+      "", ""};
+  auto x = [](Foot foot, double offset) {
+    return FormatNumber(static_cast<double>(FootIndex(foot)) + 1.0 + offset);
+  };
   std::string plot;
   int block = 0;
-  auto add_block = [&](const std::string& comment, const std::string& rows, const std::string& style) {
+  auto add_block = [&](const std::string& comment, const std::string& rows,
+                       const std::string& style) {
     if (rows.empty()) return;
     figure.data += "# block " + std::to_string(block) + ": " + comment + "\n" + rows + "\n\n";
     plot += std::string(plot.empty() ? "  plot " : ", \\\n       ") + "\"montecarlo.dat\" index " +
@@ -433,7 +445,8 @@ std::optional<ReportFigure> MonteCarloFigure(const ReportCalibration& calibratio
   };
   std::string trials, ranges, draws, at_fit;
   for (const fit::FootTarget& target : calibration.targets) {
-    for (const double value : target.liftoff_rad) trials += x(target.foot, -0.15) + " " + FormatNumber(value) + "\n";
+    for (const double value : target.liftoff_rad)
+      trials += x(target.foot, -0.15) + " " + FormatNumber(value) + "\n";
     ranges += x(target.foot, -0.25) + " " + FormatNumber(target.summary.mean) + " " +
               FormatNumber(target.summary.min) + " " + FormatNumber(target.summary.max) + "\n";
     const double run = AtFitRad(calibration, target.foot);
@@ -449,17 +462,20 @@ std::optional<ReportFigure> MonteCarloFigure(const ReportCalibration& calibratio
             "using 1:2 with points pt 7 ps 1.2 lc rgb \"#1f77b4\" title \"hardware trials\"");
   add_block("hardware range: x mean_rad min_rad max_rad", ranges,
             "using 1:2:3:4 with yerrorbars pt 0 lw 2 lc rgb \"#1f77b4\" title \"hardware range\"");
-  add_block("Monte Carlo draws: x liftoff_rad", draws,
-            "using 1:2 with points pt 6 ps 0.8 lc rgb \"#d62728\" title \"simulated, Monte Carlo over "
-            "Table I\"");
+  add_block(
+      "Monte Carlo draws: x liftoff_rad", draws,
+      "using 1:2 with points pt 6 ps 0.8 lc rgb \"#d62728\" title \"simulated, Monte Carlo over "
+      "Table I\"");
   add_block("simulation at the fitted tension: x liftoff_rad", at_fit,
-            "using 1:2 with points pt 5 ps 1.5 lc rgb \"black\" title \"simulated at the fitted tension\"");
+            "using 1:2 with points pt 5 ps 1.5 lc rgb \"black\" title \"simulated at the fitted "
+            "tension\"");
   figure.body =
       "  set title \"Liftoff rotation per foot: hardware beside the simulation's spread over the "
       "spring constants\"\n"
       "  set ylabel \"|vertebra rotation| at liftoff (rad)\"\n"
       "  set xtics (\"A\" 1, \"B\" 2, \"C\" 3, \"D\" 4)\n  set xrange [0.5:4.5]\n"
-      "  set grid ytics\n  set key outside right\n" + plot + "\n  set xtics autofreq\n";
+      "  set grid ytics\n  set key outside right\n" +
+      plot + "\n  set xtics autofreq\n";
   return figure;
 }
 
@@ -478,23 +494,27 @@ std::vector<ReportFigure> CalibrationFigures(const ReportCalibration& calibratio
 std::string CalibrationMarkdown(const ReportCalibration& calibration, const std::string& heading) {
   const ReportCommand& command = *calibration.command;
   std::string text = heading + " Calibration\n\n";
-  text += "Metric: per foot with at least two trials, z = (simulated liftoff rotation - the "
-          "trials' mean) / the standard error of that mean (sd / sqrt(n), at least 0.001 rad); a "
-          "tension's agreement over the feet is chi2 = sum of z^2 (smaller is better). A point "
-          "where a foot's test did not stand or lift ranks after every complete one. The "
-          "tension scale sigma is the coordinate of the calibration's tension points (paper "
-          "Table III, -2 low .. +2 high), stiffnesses linear between them and on the end "
-          "segments' lines beyond.\n\n";
-  if (calibration.targets.empty()) text += "No calibration: " + calibration.fit_status.ToString() + "\n\n";
+  text +=
+      "Metric: per foot with at least two trials, z = (simulated liftoff rotation - the "
+      "trials' mean) / the standard error of that mean (sd / sqrt(n), at least 0.001 rad); a "
+      "tension's agreement over the feet is chi2 = sum of z^2 (smaller is better). A point "
+      "where a foot's test did not stand or lift ranks after every complete one. The "
+      "tension scale sigma is the coordinate of the calibration's tension points (paper "
+      "Table III, -2 low .. +2 high), stiffnesses linear between them and on the end "
+      "segments' lines beyond.\n\n";
+  if (calibration.targets.empty())
+    text += "No calibration: " + calibration.fit_status.ToString() + "\n\n";
   text += RankingMarkdown(calibration, heading);
   if (!calibration.targets.empty()) text += FitMarkdown(calibration, command, heading);
   text += MonteCarloMarkdown(calibration, command, heading);
-  text += heading + "# Files\n\n"
+  text += heading +
+          "# Files\n\n"
           "- calibration.json: the campaign's calibration with the tension point \"fitted\" "
           "(or, when the fit falls on one of its points, a note on that point; `liftoff calib "
           "calibration.json`; absent without a fit)\n"
           "- figures/fit and figures/montecarlo: .gp scripts with their .dat data\n"
-          "- simulated runs cached in " + calibration.cache_path.string() +
+          "- simulated runs cached in " +
+          calibration.cache_path.string() +
           (calibration.from_cache ? " (read from it)" : " (run now)") + "\n";
   return text;
 }
@@ -506,7 +526,8 @@ std::string CalibrationHtml(const ReportCalibration& calibration) {
 Status WriteCalibrationFiles(const ReportCalibration& calibration, const fs::path& dir) {
   if (calibration.fit) {
     LIFTOFF_RETURN_IF_ERROR(calibration.fitted.Validate());
-    LIFTOFF_RETURN_IF_ERROR(WriteJsonFile(dir / "calibration.json", CalibrationToJson(calibration.fitted)));
+    LIFTOFF_RETURN_IF_ERROR(
+        WriteJsonFile(dir / "calibration.json", CalibrationToJson(calibration.fitted)));
   }
   return WriteFileAtomically(dir / "calibration.md", CalibrationMarkdown(calibration, "#"));
 }
@@ -516,7 +537,8 @@ std::string CalibrationSummary(const ReportCalibration& calibration) {
   if (!calibration.ranking.overall.empty()) {
     const fit::PointAgreement& best = calibration.ranking.overall.front();
     text += "best tension point " + best.tension.name +
-            (best.complete ? " (chi2 " + FormatFixed(best.chi_square, 1) + ")" : " (incomplete)") + "; ";
+            (best.complete ? " (chi2 " + FormatFixed(best.chi_square, 1) + ")" : " (incomplete)") +
+            "; ";
   }
   if (calibration.fit) {
     text += "fitted " + calibration.fit->Brief();

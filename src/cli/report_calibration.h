@@ -79,7 +79,8 @@ std::string CalibrationHtml(const ReportCalibration& calibration);
 
 /// Writes DIR/calibration.json (the fitted calibration; nothing without a fit) and
 /// DIR/calibration.md.
-Status WriteCalibrationFiles(const ReportCalibration& calibration, const std::filesystem::path& dir);
+Status WriteCalibrationFiles(const ReportCalibration& calibration,
+                             const std::filesystem::path& dir);
 
 /// One line for the terminal: "calibration: best point high; fitted sigma 2.31 +- ...".
 std::string CalibrationSummary(const ReportCalibration& calibration);

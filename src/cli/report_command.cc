@@ -22,7 +22,6 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
-#include "report_calibration.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/markup.h"
@@ -30,6 +29,7 @@
 #include "liftoff/core/version.h"
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
+#include "report_calibration.h"
 
 extern char** environ;
 
@@ -590,7 +590,9 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
     auto checked = SweepOptionsFrom(command.sweep);
     if (!checked.ok()) return ReportError(checked.status(), err);
     if (Status fit = command.fit.Validate(); !fit.ok()) {
-      return ReportError(InvalidArgumentError("--fit-min/--fit-max/--fit-step/--bootstrap: " + fit.message()), err);
+      return ReportError(
+          InvalidArgumentError("--fit-min/--fit-max/--fit-step/--bootstrap: " + fit.message()),
+          err);
     }
     if (Status mc = command.monte_carlo.Validate(); !mc.ok()) {
       return ReportError(InvalidArgumentError("--mc-samples/--mc-sd-scale: " + mc.message()), err);
@@ -616,8 +618,9 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
   const std::vector<stats::TrialValue> values = campaign->analysis.Values();
   std::optional<ReportCalibration> calibration;
   if (sim) {
-    auto calibrated = CalibrateCampaign(command, campaign->calibration, values, sim->results,
-                                        fs::path(sim->cache_path).replace_extension(".calibration.json"), err);
+    auto calibrated =
+        CalibrateCampaign(command, campaign->calibration, values, sim->results,
+                          fs::path(sim->cache_path).replace_extension(".calibration.json"), err);
     if (!calibrated.ok()) return ReportError(calibrated.status(), err);
     calibration = std::move(calibrated).value();
   }

@@ -172,8 +172,8 @@ void AddReachWarnings(const std::vector<FootTarget>& targets, const Curves& curv
     warnings.push_back("foot " + std::string(FootName(targets[f].foot)) + ": the hardware mean " +
                        FormatFixed(mean, 3) + " rad lies " + (mean > *high ? "above" : "below") +
                        " every simulated value for sigma " + FormatFixed(curves.sigma.front(), 2) +
-                       " .. " + FormatFixed(curves.sigma.back(), 2) + " (" +
-                       FormatFixed(*low, 3) + " .. " + FormatFixed(*high, 3) + " rad)");
+                       " .. " + FormatFixed(curves.sigma.back(), 2) + " (" + FormatFixed(*low, 3) +
+                       " .. " + FormatFixed(*high, 3) + " rad)");
   }
 }
 
@@ -194,8 +194,8 @@ void JudgeGoodness(TensionFit& fit, const FitOptions& options) {
     fit.warnings.push_back(
         "poor fit: chi2 " + FormatFixed(fit.chi_square, 1) + " for " +
         Plural(fit.degrees_of_freedom, "degree") + " of freedom (chi2/dof " +
-        FormatFixed(fit.chi_square_per_dof, 1) + "; above " + FormatFixed(limit, 1) +
-        ", p < " + FormatNumber(options.poor_fit_p) +
+        FormatFixed(fit.chi_square_per_dof, 1) + "; above " + FormatFixed(limit, 1) + ", p < " +
+        FormatNumber(options.poor_fit_p) +
         "): no tension of this model matches every foot within the trials' spread; the "
         "bootstrap interval knows only that spread (scaled by sqrt(chi2/dof): +- " +
         FormatFixed(fit.sigma_stddev_scaled, 2) + ")");
@@ -242,7 +242,8 @@ Result<std::vector<FootTarget>> TargetsFromTrials(const std::vector<stats::Trial
     targets.push_back(std::move(target));
   }
   if (targets.empty()) {
-    return InvalidArgumentError("no foot has two or more trials with a value; nothing to calibrate");
+    return InvalidArgumentError(
+        "no foot has two or more trials with a value; nothing to calibrate");
   }
   return targets;
 }
@@ -344,8 +345,8 @@ Ranking RankTensionPoints(const std::vector<FootTarget>& targets,
       FootAgreement& foot = point.feet.emplace_back();
       foot.foot = target.foot;
       foot.sim_rad = sample.liftoff_rad[FootIndex(target.foot)];
-      foot.z = foot.sim_rad ? (*foot.sim_rad - target.summary.mean) / target.standard_error_rad
-                            : kNaN;
+      foot.z =
+          foot.sim_rad ? (*foot.sim_rad - target.summary.mean) / target.standard_error_rad : kNaN;
       if (foot.sim_rad) point.chi_square += foot.z * foot.z;
       point.complete = point.complete && foot.sim_rad.has_value();
     }
@@ -363,7 +364,8 @@ Ranking RankTensionPoints(const std::vector<FootTarget>& targets,
   for (size_t f = 0; f < targets.size(); ++f) {
     std::vector<std::pair<double, std::string>> by_distance;
     for (const PointAgreement& point : ranking.overall) {
-      if (point.feet[f].sim_rad) by_distance.emplace_back(std::abs(point.feet[f].z), point.tension.name);
+      if (point.feet[f].sim_rad)
+        by_distance.emplace_back(std::abs(point.feet[f].z), point.tension.name);
     }
     std::stable_sort(by_distance.begin(), by_distance.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -383,8 +385,9 @@ Status FitOptions::Validate() const {
                                 FormatNumber(sigma_min) + ", " + FormatNumber(sigma_max));
   }
   if (!(sigma_step > 0.0 && (sigma_max - sigma_min) / sigma_step <= 1000.0)) {
-    return InvalidArgumentError("sigma_step: expected a number > 0 giving at most 1000 steps, got " +
-                                FormatNumber(sigma_step));
+    return InvalidArgumentError(
+        "sigma_step: expected a number > 0 giving at most 1000 steps, got " +
+        FormatNumber(sigma_step));
   }
   if (bootstrap_samples < 10 || bootstrap_samples > 1000000) {
     return InvalidArgumentError("bootstrap_samples: expected an integer in [10, 1000000], got " +
@@ -400,12 +403,13 @@ Status FitOptions::Validate() const {
 std::vector<TensionPoint> GridTensionPoints(const std::vector<TensionPoint>& points,
                                             const FitOptions& options) {
   std::vector<TensionPoint> grid;
-  const int steps =
-      static_cast<int>(std::floor((options.sigma_max - options.sigma_min) / options.sigma_step + 1e-9));
+  const int steps = static_cast<int>(
+      std::floor((options.sigma_max - options.sigma_min) / options.sigma_step + 1e-9));
   for (int i = 0; i <= steps; ++i) {
     const double sigma = options.sigma_min + i * options.sigma_step;
     const std::string sign = sigma < 0.0 ? "-" : "+";
-    grid.push_back(TensionAtSigma(points, sigma, "sigma=" + sign + FormatFixed(std::abs(sigma), 2)));
+    grid.push_back(
+        TensionAtSigma(points, sigma, "sigma=" + sign + FormatFixed(std::abs(sigma), 2)));
   }
   return grid;
 }
@@ -489,8 +493,9 @@ Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration
   SplitMix64 random(options.seed);
   auto draw = [&](const MaterialConstant& material) {
     for (;;) {
-      const double value = material.stiffness_n_per_m +
-                           options.stddev_scale * material.stiffness_stddev_n_per_m * Gaussian(random);
+      const double value = material.stiffness_n_per_m + options.stddev_scale *
+                                                            material.stiffness_stddev_n_per_m *
+                                                            Gaussian(random);
       if (value >= 0.01 * material.stiffness_n_per_m) return value;
     }
   };

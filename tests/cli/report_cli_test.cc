@@ -184,9 +184,9 @@ TEST(CliReport, SampleCampaignTableFiguresAndPages) {
   const std::string markdown = ReadFile(dir / "report.md");
   EXPECT_THAT(markdown, HasSubstr("## Calibration"));
   const std::string section = ReadFile(dir / "calibration.md");
-  for (const std::string part : {"# Calibration", "## Tension points ranked", "| 1 | ",
-                                 "## Fitted tension scale", "## Monte Carlo over the spring",
-                                 "4 draws (seed 2018", "chi2 = sum of z^2", "(run now)"}) {
+  for (const std::string part :
+       {"# Calibration", "## Tension points ranked", "| 1 | ", "## Fitted tension scale",
+        "## Monte Carlo over the spring", "4 draws (seed 2018", "chi2 = sum of z^2", "(run now)"}) {
     EXPECT_THAT(section, HasSubstr(part));
   }
   auto fitted = LoadCalibration(dir / "calibration.json");
@@ -198,9 +198,9 @@ TEST(CliReport, SampleCampaignTableFiguresAndPages) {
   EXPECT_LT(point->sigma, 3.0);
   EXPECT_NE(point->sigma, 2.0);
   // on Table III's line: mean (0) 237 .. high (2) 258, then 10.5 N/m per sigma
-  EXPECT_NEAR(point->silicone_n_per_m,
-              point->sigma <= 2.0 ? 237.0 + 10.5 * point->sigma : 258.0 + 10.0 * (point->sigma - 2.0),
-              0.6);
+  EXPECT_NEAR(
+      point->silicone_n_per_m,
+      point->sigma <= 2.0 ? 237.0 + 10.5 * point->sigma : 258.0 + 10.0 * (point->sigma - 2.0), 0.6);
   for (const std::string name : {"fit", "montecarlo"}) {
     EXPECT_TRUE(fs::exists(dir / "figures" / (name + ".gp"))) << name;
     EXPECT_TRUE(fs::exists(dir / "figures" / (name + ".dat"))) << name;
@@ -308,7 +308,10 @@ TEST(CliReport, RefusesBadCalibrationOptionsBeforeWritingAnything) {
   command.monte_carlo.samples = -1;
   const CommandRun run = RunReportCommand(command);
   EXPECT_EQ(run.code, ExitCodeFor(StatusCode::kInvalidArgument));
-  EXPECT_THAT(run.err, HasSubstr("--mc-samples/--mc-sd-scale: samples: expected an integer in [0, 1000000], got -1"));
+  EXPECT_THAT(
+      run.err,
+      HasSubstr(
+          "--mc-samples/--mc-sd-scale: samples: expected an integer in [0, 1000000], got -1"));
   command = SampleReport(scratch / "report");
   command.fit.sigma_step = 0.0;
   const CommandRun step = RunReportCommand(command);

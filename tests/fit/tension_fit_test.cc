@@ -78,10 +78,10 @@ TEST(TensionAtSigma, FollowsTheCalibrationsPointsAndExtendsTheirLine) {
 
 TEST(TargetsFromTrials, WeighsEachFootByItsStandardErrorAndSkipsSingleTrials) {
   std::vector<std::string> skipped;
-  auto targets = TargetsFromTrials({Trial(Foot::kA, 0.40), Trial(Foot::kA, 0.44),
-                                    Trial(Foot::kB, 0.5), Trial(Foot::kC, 0.3),
-                                    Trial(Foot::kC, 0.3)},
-                                   {}, &skipped);
+  auto targets =
+      TargetsFromTrials({Trial(Foot::kA, 0.40), Trial(Foot::kA, 0.44), Trial(Foot::kB, 0.5),
+                         Trial(Foot::kC, 0.3), Trial(Foot::kC, 0.3)},
+                        {}, &skipped);
   ASSERT_TRUE(targets.ok()) << targets.status().ToString();
   ASSERT_EQ(targets->size(), 2u);
   // A: sd 0.02 * sqrt(2) over sqrt(2) = 0.02; C: identical trials take the floor
@@ -100,14 +100,13 @@ TEST(RankTensionPoints, PutsThePointTheTrialsWereMadeFromFirst) {
     result.liftoff_rad[2] = c;
     return result;
   };
-  const std::vector<TensionSample> samples = {sample("sagged", 0.45, std::nullopt),
-                                              sample("low", 0.38, 0.33),
-                                              sample("middle", 0.45, 0.40),
-                                              sample("high", 0.52, 0.47)};
-  auto targets = TargetsFromTrials({Trial(Foot::kA, 0.44), Trial(Foot::kA, 0.46),
-                                    Trial(Foot::kA, 0.45), Trial(Foot::kC, 0.39),
-                                    Trial(Foot::kC, 0.41)},
-                                   {});
+  const std::vector<TensionSample> samples = {
+      sample("sagged", 0.45, std::nullopt), sample("low", 0.38, 0.33), sample("middle", 0.45, 0.40),
+      sample("high", 0.52, 0.47)};
+  auto targets =
+      TargetsFromTrials({Trial(Foot::kA, 0.44), Trial(Foot::kA, 0.46), Trial(Foot::kA, 0.45),
+                         Trial(Foot::kC, 0.39), Trial(Foot::kC, 0.41)},
+                        {});
   ASSERT_TRUE(targets.ok());
   const Ranking ranking = RankTensionPoints(*targets, samples);
   ASSERT_EQ(ranking.overall.size(), 4u);
@@ -149,7 +148,8 @@ TEST(FitTension, RecoversTheTensionSyntheticTrialsWereMadeAt) {
   options.sigma_min = -0.5;
   options.sigma_max = 2.0;
   options.sigma_step = 0.25;
-  auto grid = SimulateTensions(model, sweep, GridTensionPoints(calibration.tension_points, options));
+  auto grid =
+      SimulateTensions(model, sweep, GridTensionPoints(calibration.tension_points, options));
   ASSERT_TRUE(grid.ok()) << grid.status().ToString();
   auto targets = TargetsFromTrials(trials, {});
   ASSERT_TRUE(targets.ok());
@@ -178,9 +178,9 @@ TEST(FitTension, SaysWhereTheFitIsPoor) {
     sample.liftoff_rad[0] = 0.40 + 0.03 * i;
     sample.liftoff_rad[2] = 0.40 + 0.03 * i;
   }
-  auto targets = TargetsFromTrials({Trial(Foot::kA, 0.56), Trial(Foot::kA, 0.58),
-                                    Trial(Foot::kC, 0.29), Trial(Foot::kC, 0.31)},
-                                   {});
+  auto targets = TargetsFromTrials(
+      {Trial(Foot::kA, 0.56), Trial(Foot::kA, 0.58), Trial(Foot::kC, 0.29), Trial(Foot::kC, 0.31)},
+      {});
   ASSERT_TRUE(targets.ok());
   auto fit = FitTension(*targets, grid, Laika2018().tension_points, {});
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
