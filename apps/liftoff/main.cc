@@ -200,6 +200,25 @@ int main(int argc, char** argv) {
   report_app->add_option("--threads", report.sweep.threads, "Sweep worker threads (0: all cores)")
       ->capture_default_str();
   AddSimFlags(report_app, report.sweep.experiment);  // its --progress is the report's too
+  report_app->add_option("--fit-min", report.fit.sigma_min, "Tension scale fitted from (sigma)")
+      ->capture_default_str();
+  report_app->add_option("--fit-max", report.fit.sigma_max, "... to (sigma)")
+      ->capture_default_str();
+  report_app->add_option("--fit-step", report.fit.sigma_step, "Simulated every (sigma)")
+      ->capture_default_str();
+  report_app
+      ->add_option("--bootstrap", report.fit.bootstrap_samples, "Bootstrap resamples of the fit")
+      ->capture_default_str();
+  report_app
+      ->add_option("--mc-samples", report.monte_carlo.samples,
+                   "Monte Carlo draws of the spring constants (0: none)")
+      ->capture_default_str();
+  report_app->add_option("--mc-seed", report.monte_carlo.seed, "Monte Carlo seed")
+      ->capture_default_str();
+  report_app
+      ->add_option("--mc-sd-scale", report.monte_carlo.stddev_scale,
+                   "Monte Carlo: Table I's standard deviations times this")
+      ->capture_default_str();
 
   Import2018Command import;
   CLI::App* import_app = app.add_subcommand(

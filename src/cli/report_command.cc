@@ -29,6 +29,7 @@
 #include "liftoff/core/version.h"
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
+#include "report_calibration.h"
 
 extern char** environ;
 
@@ -377,6 +378,8 @@ struct ReportContent {
   const std::vector<stats::TrialValue>* values = nullptr;
   const stats::ResultsTable* table = nullptr;
   const SimColumn* sim = nullptr;
+  /// The calibration (with the simulation).
+  const ReportCalibration* calibration = nullptr;
   std::vector<Figure> figures;
   /// OK when gnuplot drew every figure.
   Status drawn;
@@ -425,6 +428,7 @@ std::string ReportMarkdown(const ReportContent& content) {
     text += "Script [figures/" + figure.name + ".gp](figures/" + figure.name + ".gp), data [figures/" +
             figure.name + ".dat](figures/" + figure.name + ".dat)\n\n";
   }
+  if (content.calibration) text += CalibrationMarkdown(*content.calibration, "##") + "\n";
   text += "## Trials\n\n";
   const auto& outcomes = content.campaign->analysis.outcomes;
   for (size_t i = 0; i < outcomes.size(); ++i) {
@@ -492,6 +496,7 @@ Result<std::string> ReportHtml(const ReportContent& content, const fs::path& fig
     html += "<figure><img alt=\"" + EscapeMarkup(figure.title) + "\" src=\"data:image/png;base64," +
             Base64(png) + "\"><figcaption>" + EscapeMarkup(figure.title) + "</figcaption></figure>\n";
   }
+  if (content.calibration) html += CalibrationHtml(*content.calibration);
   html += "<h2>Trials</h2>\n<ul>\n";
   const auto& outcomes = content.campaign->analysis.outcomes;
   for (size_t i = 0; i < outcomes.size(); ++i) {
@@ -533,6 +538,12 @@ Status WriteFiguresAndPages(ReportContent& content) {
       content.figures.push_back(std::move(*figure7));
     }
   }
+  if (content.calibration) {
+    for (ReportFigure& figure : CalibrationFigures(*content.calibration)) {
+      content.figures.push_back({figure.name, figure.title, figure.data, figure.body});
+    }
+    LIFTOFF_RETURN_IF_ERROR(WriteCalibrationFiles(*content.calibration, dir));
+  }
   for (const Figure& figure : content.figures) {
     LIFTOFF_RETURN_IF_ERROR(WriteFigure(figure, figures_dir, content.command->gnuplot, content.drawn));
   }
@@ -560,6 +571,7 @@ void PrintSummary(const ReportContent& content, std::ostream& out) {
     out << "simulation: " << (content.sim->from_cache ? "from the cache " : "ran and cached in ")
         << content.sim->cache_path.string() << "\n";
   }
+  if (content.calibration) out << CalibrationSummary(*content.calibration) << "\n";
   if (!content.drawn.ok()) {
     out << "figures: not drawn (" << content.drawn.ToString()
         << "); scripts and data are in " << (content.command->output_dir / "figures").string()
@@ -577,6 +589,14 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
   if (!command.no_sim) {
     auto checked = SweepOptionsFrom(command.sweep);
     if (!checked.ok()) return ReportError(checked.status(), err);
+    if (Status fit = command.fit.Validate(); !fit.ok()) {
+      return ReportError(
+          InvalidArgumentError("--fit-min/--fit-max/--fit-step/--bootstrap: " + fit.message()),
+          err);
+    }
+    if (Status mc = command.monte_carlo.Validate(); !mc.ok()) {
+      return ReportError(InvalidArgumentError("--mc-samples/--mc-sd-scale: " + mc.message()), err);
+    }
   }
 
   // the trials, as the table command analyses them
@@ -594,8 +614,18 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
     sim = std::move(column).value();
   }
 
-  // the table, the figures, the pages
+  // the calibration: tension points ranked, the tension scale fitted, the Monte Carlo
   const std::vector<stats::TrialValue> values = campaign->analysis.Values();
+  std::optional<ReportCalibration> calibration;
+  if (sim) {
+    auto calibrated =
+        CalibrateCampaign(command, campaign->calibration, values, sim->results,
+                          fs::path(sim->cache_path).replace_extension(".calibration.json"), err);
+    if (!calibrated.ok()) return ReportError(calibrated.status(), err);
+    calibration = std::move(calibrated).value();
+  }
+
+  // the table, the figures, the pages
   const stats::ResultsTable table = stats::BuildResultsTable(
       values, sim ? &sim->results : nullptr, campaign->analysis.calibration,
       std::string(sync::LookupRuleName(campaign->analysis.rule)));
@@ -605,6 +635,7 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
   content.values = &values;
   content.table = &table;
   content.sim = sim ? &*sim : nullptr;
+  content.calibration = calibration ? &*calibration : nullptr;
   const Status written = WriteFiguresAndPages(content);
   if (!written.ok()) return ReportError(written, err);
   if (!content.drawn.ok()) err << "warning: figures: " << content.drawn.ToString() << '\n';

@@ -13,6 +13,7 @@
 
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/sim_commands.h"
+#include "liftoff/fit/tension_fit.h"
 
 namespace liftoff::cli {
 
@@ -32,6 +33,11 @@ struct ReportCommand {
   bool no_sim = false;
   /// Folder of cached sweeps (<key>.json); empty: DIR/sim-cache.
   std::filesystem::path cache_dir;
+  /// The calibration (with the simulation): the tension scale's grid, bootstrap and
+  /// goodness-of-fit threshold, and the Monte Carlo over the spring constants (its runs are
+  /// cached beside the sweep's, keyed by these options too).
+  fit::FitOptions fit;
+  fit::MonteCarloOptions monte_carlo;
   /// The gnuplot program (found on the PATH unless a path is given).
   std::string gnuplot = "gnuplot";
 };

@@ -1,0 +1,237 @@
+// Calibration of the simulation against a hardware campaign: which tension point agrees
+// best with the trials, the continuous tension scale that fits them best (with an
+// uncertainty from the trials' spread), and a Monte Carlo over the cable materials'
+// spring constants (paper Table I).
+//
+// The tension scale is `sigma`, the coordinate of the calibration's tension points (paper
+// Table III: -2 low .. +2 high): the silicone and Buna-N stiffnesses at any sigma are the
+// piecewise-linear line through the calibration's points, extended linearly past its ends
+// (TensionAtSigma).
+//
+// The agreement metric, per foot f with n_f >= 2 hardware trials of mean m_f and sample
+// standard deviation s_f: z_f = (sim_f - m_f) / se_f, se_f = max(s_f / sqrt(n_f),
+// standard_error_floor_rad); over the feet, chi-square = sum of z_f^2. A foot whose
+// simulation has no value there (the robot did not stand, the foot did not lift) makes
+// the point incomplete: ranked after every complete point.
+//
+//   LIFTOFF_ASSIGN_OR_RETURN(auto targets, fit::TargetsFromTrials(values, {}));
+//   LIFTOFF_ASSIGN_OR_RETURN(auto grid, fit::SimulateTensions(model, sweep,
+//                                           fit::GridTensionPoints(calibration, options)));
+//   LIFTOFF_ASSIGN_OR_RETURN(fit::TensionFit fitted, fit::FitTension(targets, grid, options));
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "liftoff/core/calibration.h"
+#include "liftoff/core/robot.h"
+#include "liftoff/core/status.h"
+#include "liftoff/sim/model.h"
+#include "liftoff/sim/sweep.h"
+#include "liftoff/stats/statistics.h"
+#include "liftoff/stats/table.h"
+
+namespace liftoff::fit {
+
+// ---------------------------------------------------------------------------------------
+// the hardware side
+
+/// One foot's hardware trials, as the fit sees them.
+struct FootTarget {
+  Foot foot = Foot::kA;
+  /// The trials' |liftoff rotations|, rad (finite values only), in input order.
+  std::vector<double> liftoff_rad;
+  /// Their summary (mean, sd, range), rad.
+  stats::Summary summary;
+  /// Standard error of the mean used as the foot's weight, rad (> 0).
+  double standard_error_rad = 0.0;
+};
+
+struct TargetOptions {
+  /// Smallest standard error a foot is given, rad (> 0): the lookup's and the
+  /// simulation's resolution, so identical trials do not weigh infinitely.
+  double standard_error_floor_rad = 0.001;
+
+  Status Validate() const;
+};
+
+/// Per foot (A..D order) with at least two finite trial values; a foot with fewer is left
+/// out and named in `skipped` (may be null). kInvalidArgument when no foot has two.
+Result<std::vector<FootTarget>> TargetsFromTrials(const std::vector<stats::TrialValue>& values,
+                                                  const TargetOptions& options,
+                                                  std::vector<std::string>* skipped = nullptr);
+
+// ---------------------------------------------------------------------------------------
+// the simulated side
+
+/// The simulation at one tension: each foot's |liftoff rotation| when its test stood and
+/// the foot lifted.
+struct TensionSample {
+  TensionPoint tension;
+  /// Indexed by Foot; nullopt: not simulated, did not stand, or no liftoff.
+  std::array<std::optional<double>, 4> liftoff_rad;
+};
+
+/// The stiffnesses at tension scale `sigma` on the calibration's tension-point line
+/// (piecewise linear in sigma, extended linearly past the end points; a single point: its
+/// stiffnesses). The spring is interpolated the same way. Named `name`.
+TensionPoint TensionAtSigma(const std::vector<TensionPoint>& points, double sigma,
+                            const std::string& name);
+
+/// Runs the sweep's feet at `points` (names unique) with liftoff's engine (sim::RunSweep,
+/// options from `sweep`: experiment, feet, threads). Errors as RunSweep's.
+Result<std::vector<TensionSample>> SimulateTensions(const sim::ModelDescription& model,
+                                                    const sim::SweepOptions& sweep,
+                                                    const std::vector<TensionPoint>& points);
+
+/// The samples as JSON ({"samples": [...]}, for caches) and back; `source` names the data
+/// in errors.
+nlohmann::json TensionSamplesToJson(const std::vector<TensionSample>& samples);
+Result<std::vector<TensionSample>> TensionSamplesFromJson(const nlohmann::json& document,
+                                                          const std::string& source);
+
+// ---------------------------------------------------------------------------------------
+// ranking the tension points
+
+/// One foot at one tension.
+struct FootAgreement {
+  Foot foot = Foot::kA;
+  /// The simulated value, rad (nullopt: none there).
+  std::optional<double> sim_rad;
+  /// (sim - hardware mean) / standard error; NaN without a simulated value.
+  double z = 0.0;
+};
+
+/// One tension point against the hardware.
+struct PointAgreement {
+  TensionPoint tension;
+  /// One per target foot, in the targets' order.
+  std::vector<FootAgreement> feet;
+  /// Sum of z^2 over the feet with a value.
+  double chi_square = 0.0;
+  /// Whether every target foot has a simulated value here.
+  bool complete = false;
+};
+
+struct Ranking {
+  /// Every point, best first: complete points by chi-square, then incomplete ones by
+  /// their number of missing feet and chi-square.
+  std::vector<PointAgreement> overall;
+  /// Per target foot (targets' order): the points' names with a value for that foot,
+  /// best (smallest |z|) first.
+  std::vector<std::pair<Foot, std::vector<std::string>>> per_foot;
+
+  /// "high (chi2 812.4), med-high (chi2 1032.0), ..."
+  std::string Brief() const;
+};
+
+/// Ranks `samples` (names unique) by agreement with `targets`.
+Ranking RankTensionPoints(const std::vector<FootTarget>& targets,
+                          const std::vector<TensionSample>& samples);
+
+// ---------------------------------------------------------------------------------------
+// fitting the tension scale
+
+struct FitOptions {
+  /// The simulated grid of tension scales: from sigma_min to sigma_max (inclusive) every
+  /// sigma_step. Default: the paper's points' -2 .. +2 and two SDs beyond the high one,
+  /// so a fit that wants more tension says so rather than stopping at the paper's end.
+  double sigma_min = -2.0;
+  double sigma_max = 4.0;
+  double sigma_step = 0.25;
+  /// Bootstrap resamples of the trials (>= 10) and their seed.
+  int bootstrap_samples = 1000;
+  uint64_t seed = 2018;
+  /// Goodness-of-fit threshold: the fit is called poor when chi-square exceeds its
+  /// (1 - poor_fit_p) quantile for the degrees of freedom (0 < p < 1).
+  double poor_fit_p = 0.01;
+
+  /// kInvalidArgument naming the field.
+  Status Validate() const;
+};
+
+/// The grid's tension points ("sigma=-2.00" .. ), TensionAtSigma on `points`.
+std::vector<TensionPoint> GridTensionPoints(const std::vector<TensionPoint>& points,
+                                            const FitOptions& options);
+
+struct TensionFit {
+  /// Best tension scale on the simulated curves (linear between grid points), and its
+  /// stiffnesses (named "fitted").
+  double sigma = 0.0;
+  TensionPoint tension;
+  /// Bootstrap over each foot's trials (resampled with replacement, weights kept):
+  /// standard deviation of the refitted sigma and its 2.5 % and 97.5 % quantiles.
+  double sigma_stddev = 0.0;
+  double sigma_low95 = 0.0;
+  double sigma_high95 = 0.0;
+  /// chi-square at the fit, degrees of freedom (feet - 1), chi-square / dof (NaN when
+  /// dof = 0), and whether that is poor (FitOptions::poor_fit_p).
+  double chi_square = 0.0;
+  int degrees_of_freedom = 0;
+  double chi_square_per_dof = 0.0;
+  bool poor = false;
+  /// sigma_stddev scaled by sqrt(chi-square / dof) when that is above 1 (the spread the
+  /// misfit implies; the bootstrap alone only knows the trials' spread).
+  double sigma_stddev_scaled = 0.0;
+  /// Each target foot at the fit (interpolated).
+  std::vector<FootAgreement> feet;
+  /// The contiguous range of grid sigmas where every target foot has a value, which the
+  /// fit searched.
+  double searched_sigma_min = 0.0;
+  double searched_sigma_max = 0.0;
+  /// Things that make the fit less than it seems: at the edge of the searched range, a
+  /// foot whose hardware mean no simulated tension reaches, a poor chi-square.
+  std::vector<std::string> warnings;
+
+  /// "sigma 2.31 +- 0.12 (95 % [2.10, 2.55]), chi2/dof 311.2 (poor)"
+  std::string Brief() const;
+};
+
+/// Fits the tension scale to `targets` on `grid` (samples at increasing sigma, as
+/// GridTensionPoints gives). kInvalidArgument for bad options; kNotFound when no two
+/// neighbouring grid points have a value for every target foot.
+Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
+                              const std::vector<TensionSample>& grid,
+                              const std::vector<TensionPoint>& points, const FitOptions& options);
+
+// ---------------------------------------------------------------------------------------
+// Monte Carlo over the spring constants
+
+struct MonteCarloOptions {
+  /// Draws (>= 0; 0: no Monte Carlo). Each draw runs every foot.
+  int samples = 16;
+  uint64_t seed = 2018;
+  /// Multiplies every material's standard deviation (>= 0; 1: paper Table I).
+  double stddev_scale = 1.0;
+
+  Status Validate() const;
+};
+
+/// The draws: each material's constant from a normal distribution with its Table I mean
+/// and standard deviation (times stddev_scale), drawn independently per draw and material
+/// and applied to every cable of that material (lattice-wide, not per cable); values
+/// below 1 % of the mean are drawn again. Named "mc-0001" ..; sigma is the draw's index.
+/// kInvalidArgument when the calibration lacks silicone, buna_n or spring.
+Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration,
+                                                  const MonteCarloOptions& options);
+
+/// One foot's simulated liftoff distribution.
+struct FootDistribution {
+  Foot foot = Foot::kA;
+  /// Draws where the foot lifted, rad, in draw order.
+  std::vector<double> liftoff_rad;
+  /// Draws without a value (the robot did not stand, or the foot did not lift).
+  int missing = 0;
+  stats::Summary summary;
+};
+
+/// Per foot of the samples (A..D, feet without any value left out).
+std::vector<FootDistribution> Distributions(const std::vector<TensionSample>& samples);
+
+}  // namespace liftoff::fit
