@@ -7,10 +7,15 @@
 #include <limits>
 
 #include "liftoff/core/json.h"
+#include "band_cholesky.h"
+#include "contact_solver.h"
 
 namespace liftoff::sim {
 namespace {
 
+using internal::BandCholesky;
+using internal::BandSolveColumns;
+using internal::SolveContactImpulses;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
@@ -91,57 +96,6 @@ void AddOuter(Eigen::MatrixXd& system, Eigen::Index row, Eigen::Index col, const
   for (Eigen::Index j = 0; j < 6; ++j) {
     const double scaled = weight * b[j];
     for (Eigen::Index i = 0; i < 6; ++i) system(row + i, col + j) += scaled * a[i];
-  }
-}
-
-// In-place Cholesky factor (lower triangle) of a symmetric positive definite matrix whose
-// lower triangle is zero more than `band` below the diagonal; the factor keeps the band.
-// Only the lower triangle is read or written. Returns false if it is not positive definite.
-bool BandCholesky(Eigen::MatrixXd& a, Eigen::Index band) {
-  const Eigen::Index n = a.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double diagonal = a(k, k);
-    if (!(diagonal > 0.0)) return false;
-    const double pivot = std::sqrt(diagonal);
-    a(k, k) = pivot;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    const double inverse = 1.0 / pivot;
-    for (Eigen::Index i = k + 1; i < end; ++i) a(i, k) *= inverse;
-    for (Eigen::Index j = k + 1; j < end; ++j) {
-      const double factor = a(j, k);
-      if (factor == 0.0) continue;
-      for (Eigen::Index i = j; i < end; ++i) a(i, j) -= a(i, k) * factor;
-    }
-  }
-  return true;
-}
-
-// Solves (L L^T) X = B in place with the factor of BandCholesky, for the first `columns`
-// columns of a row-major X (rows of `stride` numbers): the columns share every pass.
-void BandSolveColumns(const Eigen::MatrixXd& l, Eigen::Index band, double* x, Eigen::Index stride,
-                      Eigen::Index columns) {
-  const Eigen::Index n = l.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    double* xk = x + k * stride;
-    const double inverse = 1.0 / l(k, k);
-    for (Eigen::Index c = 0; c < columns; ++c) xk[c] *= inverse;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    for (Eigen::Index i = k + 1; i < end; ++i) {
-      const double factor = l(i, k);
-      double* xi = x + i * stride;
-      for (Eigen::Index c = 0; c < columns; ++c) xi[c] -= factor * xk[c];
-    }
-  }
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    double* xk = x + k * stride;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    for (Eigen::Index i = k + 1; i < end; ++i) {
-      const double factor = l(i, k);
-      const double* xi = x + i * stride;
-      for (Eigen::Index c = 0; c < columns; ++c) xk[c] -= factor * xi[c];
-    }
-    const double inverse = 1.0 / l(k, k);
-    for (Eigen::Index c = 0; c < columns; ++c) xk[c] *= inverse;
   }
 }
 
@@ -517,37 +471,8 @@ void SolveContacts(const EngineOptions& options, State& state, int rows) {
   }
 
   // projected Gauss-Seidel
-  for (int sweep = 0; sweep < options.solver_iterations; ++sweep) {
-    double largest_change = 0.0;
-    for (const ContactPoint& contact : contacts) {
-      const int n = contact.first_row;
-      const double normal_velocity = scratch.row_velocity[n] + w.row(n).dot(impulse);
-      const double updated = std::max(
-          0.0, impulse[n] + (contact.target_normal_velocity_m_per_s - normal_velocity) / w(n, n));
-      largest_change = std::max(largest_change, std::abs(updated - impulse[n]));
-      impulse[n] = updated;
-      if (contact.rows == 1) continue;
-      double t[2];
-      for (int k = 0; k < 2; ++k) {
-        const int row = n + 1 + k;
-        const double tangent_velocity = scratch.row_velocity[row] + w.row(row).dot(impulse);
-        t[k] = impulse[row] - tangent_velocity / w(row, row);
-      }
-      // Coulomb: inside the cone of the current normal impulse
-      const double limit = contact.friction * impulse[n];
-      const double magnitude = std::hypot(t[0], t[1]);
-      if (magnitude > limit) {
-        const double scale = magnitude > 0.0 ? limit / magnitude : 0.0;
-        t[0] *= scale;
-        t[1] *= scale;
-      }
-      for (int k = 0; k < 2; ++k) {
-        largest_change = std::max(largest_change, std::abs(t[k] - impulse[n + 1 + k]));
-        impulse[n + 1 + k] = t[k];
-      }
-    }
-    if (largest_change <= options.solver_tolerance_n_s) break;
-  }
+  SolveContactImpulses(contacts, w, scratch.row_velocity, options.solver_iterations,
+                       options.solver_tolerance_n_s, impulse);
   scratch.velocity.noalias() += y * impulse;
 
   // remember for the next step
