@@ -1,9 +1,5 @@
 #include "liftoff/video/led_detector.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +11,7 @@
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "cell_sums.h"
 #include "led_timing.h"
 #include "video_util.h"
 
@@ -22,8 +19,10 @@ namespace liftoff::video {
 namespace {
 
 using internal::ExposureRange;
+using Grid = internal::CellGrid;
 using internal::InstantInterval;
 using internal::LitFraction;
+using internal::MeasureCells;
 using internal::MedianOf;
 using internal::RectText;
 
@@ -66,9 +65,9 @@ constexpr int kConfirmFrames = 8;
 // kGainMinLevels grey levels are left out).
 constexpr double kReferenceFrames = 64.0;
 constexpr double kGainMinLevels = 10.0;
-// Automatic locating samples every other row; the gain uses every other cell column and
-// row. With an ROI, the frame-wide statistics use every kReferenceStride-th cell.
-constexpr int kAutoRowStep = 2;
+// Automatic locating samples every other row (internal::kCellRowStep); the gain uses every
+// other cell column and row. With an ROI, the frame-wide statistics use every
+// kReferenceStride-th cell.
 constexpr int kGainStride = 2;
 constexpr int kReferenceStride = 4;
 // A measured fraction of the exposure is known to within max(sigmas * its noise, margin)
@@ -180,96 +179,6 @@ WindowShape ShapeOf(const double* values, int before_count, int after_count, boo
     shape.after_creep = std::max(shape.after_creep, along - least);
   }
   return shape;
-}
-
-// The cells of the automatic locator: origins of every cell column and row (the last one
-// flush with the frame's edge, so the whole frame is covered).
-struct Grid {
-  int cell_px = 16;
-  int columns = 0, rows = 0;
-  std::vector<int> x0_px, y0_px;
-  int sampled_px_per_cell = 0;
-
-  // every `stride`-th cell of the full grid
-  static Grid Make(int width_px, int height_px, int cell_px, int stride) {
-    Grid grid;
-    grid.cell_px = cell_px;
-    const int columns = (width_px + cell_px - 1) / cell_px;
-    const int rows = (height_px + cell_px - 1) / cell_px;
-    for (int i = 0; i < columns; i += stride) {
-      grid.x0_px.push_back(std::min(i * cell_px, width_px - cell_px));
-    }
-    for (int i = 0; i < rows; i += stride) {
-      grid.y0_px.push_back(std::min(i * cell_px, height_px - cell_px));
-    }
-    grid.columns = static_cast<int>(grid.x0_px.size());
-    grid.rows = static_cast<int>(grid.y0_px.size());
-    grid.sampled_px_per_cell = cell_px * ((cell_px + kAutoRowStep - 1) / kAutoRowStep);
-    return grid;
-  }
-  int cells() const { return columns * rows; }
-};
-
-#if defined(__SSE2__)
-// one cell at a time, its sampled rows 16 bytes per instruction, the sum and the
-// maximum kept in registers
-void MeasureCellsSse2(const cv::Mat& bgr, const Grid& grid, float* sums, uint8_t* peaks) {
-  const int chunks = grid.cell_px * 3 / 16;
-  const size_t row_stride = bgr.step[0] * static_cast<size_t>(kAutoRowStep);
-  const __m128i zero = _mm_setzero_si128();
-  for (int row = 0; row < grid.rows; ++row) {
-    const uint8_t* band = bgr.ptr<uint8_t>(grid.y0_px[static_cast<size_t>(row)]);
-    for (int column = 0; column < grid.columns; ++column) {
-      __m128i sum = zero, peak = zero;
-      const uint8_t* line = band + grid.x0_px[static_cast<size_t>(column)] * 3;
-      for (int y = 0; y < grid.cell_px; y += kAutoRowStep, line += row_stride) {
-        for (int chunk = 0; chunk < chunks; ++chunk) {
-          __m128i value;
-          std::memcpy(&value, line + 16 * chunk, sizeof value);
-          sum = _mm_add_epi64(sum, _mm_sad_epu8(value, zero));
-          peak = _mm_max_epu8(peak, value);
-        }
-      }
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 8));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 4));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 2));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 1));
-      std::array<uint64_t, 2> halves{};
-      std::memcpy(halves.data(), &sum, sizeof halves);
-      const auto cell = static_cast<size_t>(row * grid.columns + column);
-      sums[cell] = static_cast<float>(halves[0] + halves[1]);
-      peaks[cell] = static_cast<uint8_t>(_mm_cvtsi128_si32(peak) & 0xff);
-    }
-  }
-}
-#endif
-
-// Sum of B + G + R and the brightest channel value of every cell, every other row.
-void MeasureCells(const cv::Mat& bgr, const Grid& grid, float* sums, uint8_t* peaks) {
-  const int bytes_per_cell = grid.cell_px * 3;
-#if defined(__SSE2__)
-  if (bytes_per_cell % 16 == 0) {
-    MeasureCellsSse2(bgr, grid, sums, peaks);
-    return;
-  }
-#endif
-  for (int row = 0; row < grid.rows; ++row) {
-    for (int column = 0; column < grid.columns; ++column) {
-      uint32_t sum = 0;
-      uint8_t peak = 0;
-      for (int y = 0; y < grid.cell_px; y += kAutoRowStep) {
-        const uint8_t* pixel = bgr.ptr<uint8_t>(grid.y0_px[static_cast<size_t>(row)] + y) +
-                               grid.x0_px[static_cast<size_t>(column)] * 3;
-        for (int u = 0; u < bytes_per_cell; ++u) {
-          sum += pixel[u];
-          peak = std::max(peak, pixel[u]);
-        }
-      }
-      const size_t cell = static_cast<size_t>(row * grid.columns + column);
-      sums[cell] = static_cast<float>(sum);
-      peaks[cell] = peak;
-    }
-  }
 }
 
 enum class Level : uint8_t { kUnknown, kLow, kHigh };
