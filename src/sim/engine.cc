@@ -245,100 +245,115 @@ void AddGroundContact(int64_t key, int body, const Vec3& lowest_point, double fr
   contacts.push_back(contact);
 }
 
-// Every contact within the margin, in a fixed order.
-void FindContacts(const Model& model, const EngineOptions& options, State& state) {
-  StepScratch& scratch = state.scratch;
-  std::vector<ContactPoint>& contacts = scratch.contacts;
-  contacts.clear();
+// One body's contacts with the ground: its feet (and, with spine_ground, its other
+// spheres, its colliding rods' end spheres and its boxes' corners).
+void FindGroundContacts(const Model& model, const EngineOptions& options, const State& state,
+                        size_t b, std::vector<ContactPoint>& contacts) {
   const double friction = model.contact.friction;
   const double spine_friction = model.contact.spine_friction.value_or(friction);
   const double margin = options.contact_margin_m;
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const Body& body = model.bodies[b];
-    const BodyState& pose = state.bodies[b];
-    const Mat3& rotation = scratch.rotation[b];
-    const int body_index = static_cast<int>(b);
-    for (size_t s = 0; s < body.spheres.size(); ++s) {
-      const Sphere& sphere = body.spheres[s];
-      const bool foot = sphere.foot_index >= 0;
-      if (!foot && !model.contact.spine_ground) continue;
-      const Vec3 center = pose.position_m + rotation * sphere.center_m;
-      AddGroundContact(
-          ContactKey(foot ? kFootKind : kSphereKind, body_index, static_cast<int64_t>(s), 0),
-          body_index, center - Vec3(0.0, 0.0, sphere.radius_m), foot ? friction : spine_friction,
-          sphere.foot_index, margin, contacts);
-    }
-    if (!model.contact.spine_ground) continue;
-    // rods as capsules: their lowest points are on the end spheres
-    for (size_t r = 0; r < body.rods.size(); ++r) {
-      const Rod& rod = body.rods[r];
-      if (!rod.collides) continue;
-      const Vec3 ends[2] = {pose.position_m + rotation * rod.from_m,
-                            pose.position_m + rotation * rod.to_m};
-      for (int e = 0; e < 2; ++e) {
-        AddGroundContact(ContactKey(kRodEndKind, body_index, static_cast<int64_t>(r), e),
-                         body_index, ends[e] - Vec3(0.0, 0.0, rod.radius_m), spine_friction, -1,
-                         margin, contacts);
-      }
-    }
-    for (size_t x = 0; x < body.boxes.size(); ++x) {
-      const Box& box = body.boxes[x];
-      if (!box.collides) continue;
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
-                        (corner & 4) ? 1.0 : -1.0);
-        const Vec3 point =
-            pose.position_m + rotation * (box.center_m + sign.cwiseProduct(box.half_size_m));
-        AddGroundContact(ContactKey(kBoxCornerKind, body_index, static_cast<int64_t>(x), corner),
-                         body_index, point, spine_friction, -1, margin, contacts);
-      }
+  const Body& body = model.bodies[b];
+  const BodyState& pose = state.bodies[b];
+  const Mat3& rotation = state.scratch.rotation[b];
+  const int body_index = static_cast<int>(b);
+  for (size_t s = 0; s < body.spheres.size(); ++s) {
+    const Sphere& sphere = body.spheres[s];
+    const bool foot = sphere.foot_index >= 0;
+    if (!foot && !model.contact.spine_ground) continue;
+    const Vec3 center = pose.position_m + rotation * sphere.center_m;
+    AddGroundContact(
+        ContactKey(foot ? kFootKind : kSphereKind, body_index, static_cast<int64_t>(s), 0),
+        body_index, center - Vec3(0.0, 0.0, sphere.radius_m), foot ? friction : spine_friction,
+        sphere.foot_index, margin, contacts);
+  }
+  if (!model.contact.spine_ground) return;
+  // rods as capsules: their lowest points are on the end spheres
+  for (size_t r = 0; r < body.rods.size(); ++r) {
+    const Rod& rod = body.rods[r];
+    if (!rod.collides) continue;
+    const Vec3 ends[2] = {pose.position_m + rotation * rod.from_m,
+                          pose.position_m + rotation * rod.to_m};
+    for (int e = 0; e < 2; ++e) {
+      AddGroundContact(ContactKey(kRodEndKind, body_index, static_cast<int64_t>(r), e), body_index,
+                       ends[e] - Vec3(0.0, 0.0, rod.radius_m), spine_friction, -1, margin,
+                       contacts);
     }
   }
+  for (size_t x = 0; x < body.boxes.size(); ++x) {
+    const Box& box = body.boxes[x];
+    if (!box.collides) continue;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
+                      (corner & 4) ? 1.0 : -1.0);
+      const Vec3 point =
+          pose.position_m + rotation * (box.center_m + sign.cwiseProduct(box.half_size_m));
+      AddGroundContact(ContactKey(kBoxCornerKind, body_index, static_cast<int64_t>(x), corner),
+                       body_index, point, spine_friction, -1, margin, contacts);
+    }
+  }
+}
+
+// The contacts between the colliding rods of bodies b1 and b2 (capsules), unless their
+// rods' bounding spheres are apart by more than the margin.
+void FindRodPairContacts(const Model& model, const EngineOptions& options, const State& state,
+                         size_t b1, size_t b2, std::vector<ContactPoint>& contacts) {
+  const StepScratch& scratch = state.scratch;
+  const double margin = options.contact_margin_m;
+  const double spine_friction = model.contact.spine_friction.value_or(model.contact.friction);
+  if (scratch.rod_bound_radius[b1] < 0.0 || scratch.rod_bound_radius[b2] < 0.0) return;
+  const Vec3 center1 =
+      state.bodies[b1].position_m + scratch.rotation[b1] * scratch.rod_bound_center[b1];
+  const Vec3 center2 =
+      state.bodies[b2].position_m + scratch.rotation[b2] * scratch.rod_bound_center[b2];
+  const double reach = scratch.rod_bound_radius[b1] + scratch.rod_bound_radius[b2] + margin;
+  if ((center1 - center2).squaredNorm() > reach * reach) return;
+  const Body& body1 = model.bodies[b1];
+  const Body& body2 = model.bodies[b2];
+  for (size_t r1 = 0; r1 < body1.rods.size(); ++r1) {
+    const Rod& rod1 = body1.rods[r1];
+    if (!rod1.collides) continue;
+    const Vec3 p1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.from_m;
+    const Vec3 q1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.to_m;
+    for (size_t r2 = 0; r2 < body2.rods.size(); ++r2) {
+      const Rod& rod2 = body2.rods[r2];
+      if (!rod2.collides) continue;
+      const Vec3 p2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.from_m;
+      const Vec3 q2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.to_m;
+      Vec3 c1;
+      Vec3 c2;
+      ClosestPointsOfSegments(p1, q1, p2, q2, c1, c2);
+      const Vec3 between = c2 - c1;
+      const double distance = between.norm();
+      const double gap = distance - rod1.radius_m - rod2.radius_m;
+      if (gap > margin || distance < 1e-12) continue;
+      ContactPoint contact;
+      contact.key = ContactKey(kRodPairKind, static_cast<int64_t>(b1 * 256 + b2),
+                               static_cast<int64_t>(r1), static_cast<int64_t>(r2));
+      contact.body_a = static_cast<int>(b1);
+      contact.body_b = static_cast<int>(b2);
+      contact.normal = between / distance;
+      contact.point_a_m = c1 + contact.normal * rod1.radius_m;
+      contact.point_b_m = c2 - contact.normal * rod2.radius_m;
+      contact.gap_m = gap;
+      contact.friction = spine_friction;
+      contacts.push_back(contact);
+    }
+  }
+}
+
+// Every contact within the margin, in a fixed order: each body's with the ground, then
+// (with spine_self) those between the rods of bodies that move independently.
+void FindContacts(const Model& model, const EngineOptions& options, State& state) {
+  std::vector<ContactPoint>& contacts = state.scratch.contacts;
+  contacts.clear();
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    FindGroundContacts(model, options, state, b, contacts);
+  }
   if (!model.contact.spine_self) return;
-  // rods of bodies that move independently, as capsules; bodies whose rods' bounding
-  // spheres are apart by more than the margin are skipped
   for (size_t b1 = 0; b1 < model.bodies.size(); ++b1) {
     for (size_t b2 = b1 + 1; b2 < model.bodies.size(); ++b2) {
-      if (scratch.cluster_of_body[b1] == scratch.cluster_of_body[b2]) continue;
-      if (scratch.rod_bound_radius[b1] < 0.0 || scratch.rod_bound_radius[b2] < 0.0) continue;
-      const Vec3 center1 =
-          state.bodies[b1].position_m + scratch.rotation[b1] * scratch.rod_bound_center[b1];
-      const Vec3 center2 =
-          state.bodies[b2].position_m + scratch.rotation[b2] * scratch.rod_bound_center[b2];
-      const double reach = scratch.rod_bound_radius[b1] + scratch.rod_bound_radius[b2] + margin;
-      if ((center1 - center2).squaredNorm() > reach * reach) continue;
-      const Body& body1 = model.bodies[b1];
-      const Body& body2 = model.bodies[b2];
-      for (size_t r1 = 0; r1 < body1.rods.size(); ++r1) {
-        const Rod& rod1 = body1.rods[r1];
-        if (!rod1.collides) continue;
-        const Vec3 p1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.from_m;
-        const Vec3 q1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.to_m;
-        for (size_t r2 = 0; r2 < body2.rods.size(); ++r2) {
-          const Rod& rod2 = body2.rods[r2];
-          if (!rod2.collides) continue;
-          const Vec3 p2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.from_m;
-          const Vec3 q2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.to_m;
-          Vec3 c1;
-          Vec3 c2;
-          ClosestPointsOfSegments(p1, q1, p2, q2, c1, c2);
-          const Vec3 between = c2 - c1;
-          const double distance = between.norm();
-          const double gap = distance - rod1.radius_m - rod2.radius_m;
-          if (gap > margin || distance < 1e-12) continue;
-          ContactPoint contact;
-          contact.key = ContactKey(kRodPairKind, static_cast<int64_t>(b1 * 256 + b2),
-                                   static_cast<int64_t>(r1), static_cast<int64_t>(r2));
-          contact.body_a = static_cast<int>(b1);
-          contact.body_b = static_cast<int>(b2);
-          contact.normal = between / distance;
-          contact.point_a_m = c1 + contact.normal * rod1.radius_m;
-          contact.point_b_m = c2 - contact.normal * rod2.radius_m;
-          contact.gap_m = gap;
-          contact.friction = spine_friction;
-          contacts.push_back(contact);
-        }
-      }
+      if (state.scratch.cluster_of_body[b1] == state.scratch.cluster_of_body[b2]) continue;
+      FindRodPairContacts(model, options, state, b1, b2, contacts);
     }
   }
 }
