@@ -73,6 +73,10 @@ TEST(SolveContactImpulses, KeepsFrictionInsideTheCoulombCone) {
   EXPECT_NEAR(sliding[0], 2.0, 1e-12);
   EXPECT_NEAR(sliding[1], 0.5 * 2.0 * 0.6, 1e-12);
   EXPECT_NEAR(sliding[2], -0.5 * 2.0 * 0.8, 1e-12);
+  // just outside the cone (1.5 times its edge): scaled back onto it
+  const Eigen::VectorXd edge = Solve(Contacts({0.5}), w, Eigen::Vector3d(-2.0, -0.9, 1.2));
+  EXPECT_NEAR(edge[1], 0.6, 1e-12);
+  EXPECT_NEAR(edge[2], -0.8, 1e-12);
   const Eigen::VectorXd sticking = Solve(Contacts({10.0}), w, free_velocity);
   EXPECT_NEAR(sticking[0], 2.0, 1e-12);
   EXPECT_NEAR(sticking[1], 3.0, 1e-12);
