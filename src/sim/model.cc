@@ -338,6 +338,52 @@ Result<ModelDescription> LoadModelDescription(const std::filesystem::path& path)
   return ModelDescriptionFromJson(document, path.string());
 }
 
+namespace {
+
+// one body of the file: pose, nodes, and its rods, boxes and spheres when it has any
+json BodyToJson(const BodyDescription& body) {
+  json entry = {{"name", body.name}, {"position_m", ToJson(body.position_m)}};
+  const Quat& q = body.orientation;
+  if (!q.coeffs().isApprox(Quat::Identity().coeffs(), 0.0)) {
+    entry["orientation_wxyz"] = json::array({q.w(), q.x(), q.y(), q.z()});
+  }
+  json nodes = json::object();
+  for (const NodeDescription& node : body.nodes) nodes[node.name] = ToJson(node.position_m);
+  entry["nodes"] = nodes;
+  json rods = json::array();
+  for (const RodDescription& rod : body.rods) {
+    rods.push_back({{"name", rod.name},
+                    {"from", rod.from_node},
+                    {"to", rod.to_node},
+                    {"radius_m", rod.radius_m},
+                    {"density_kg_per_m3", rod.density_kg_per_m3},
+                    {"collides", rod.collides}});
+  }
+  if (!rods.empty()) entry["rods"] = rods;
+  json boxes = json::array();
+  for (const BoxDescription& box : body.boxes) {
+    boxes.push_back({{"name", box.name},
+                     {"center_m", ToJson(box.center_m)},
+                     {"size_m", ToJson(box.size_m)},
+                     {"density_kg_per_m3", box.density_kg_per_m3},
+                     {"collides", box.collides}});
+  }
+  if (!boxes.empty()) entry["boxes"] = boxes;
+  json spheres = json::array();
+  for (const SphereDescription& sphere : body.spheres) {
+    json item = {{"name", sphere.name},
+                 {"center_m", ToJson(sphere.center_m)},
+                 {"radius_m", sphere.radius_m},
+                 {"density_kg_per_m3", sphere.density_kg_per_m3}};
+    if (sphere.foot) item["foot"] = std::string(FootName(*sphere.foot));
+    spheres.push_back(item);
+  }
+  if (!spheres.empty()) entry["spheres"] = spheres;
+  return entry;
+}
+
+}  // namespace
+
 json ModelDescriptionToJson(const ModelDescription& model) {
   json document = json::object();
   document["format"] = kFormatName;
@@ -358,46 +404,7 @@ json ModelDescriptionToJson(const ModelDescription& model) {
   document["damping_cap"] = model.damping_cap;
   document["foot_marker_height_m"] = model.foot_marker_height_m;
   json bodies = json::array();
-  for (const BodyDescription& body : model.bodies) {
-    json entry = {{"name", body.name}, {"position_m", ToJson(body.position_m)}};
-    const Quat& q = body.orientation;
-    if (!q.coeffs().isApprox(Quat::Identity().coeffs(), 0.0)) {
-      entry["orientation_wxyz"] = json::array({q.w(), q.x(), q.y(), q.z()});
-    }
-    json nodes = json::object();
-    for (const NodeDescription& node : body.nodes) nodes[node.name] = ToJson(node.position_m);
-    entry["nodes"] = nodes;
-    json rods = json::array();
-    for (const RodDescription& rod : body.rods) {
-      rods.push_back({{"name", rod.name},
-                      {"from", rod.from_node},
-                      {"to", rod.to_node},
-                      {"radius_m", rod.radius_m},
-                      {"density_kg_per_m3", rod.density_kg_per_m3},
-                      {"collides", rod.collides}});
-    }
-    if (!rods.empty()) entry["rods"] = rods;
-    json boxes = json::array();
-    for (const BoxDescription& box : body.boxes) {
-      boxes.push_back({{"name", box.name},
-                       {"center_m", ToJson(box.center_m)},
-                       {"size_m", ToJson(box.size_m)},
-                       {"density_kg_per_m3", box.density_kg_per_m3},
-                       {"collides", box.collides}});
-    }
-    if (!boxes.empty()) entry["boxes"] = boxes;
-    json spheres = json::array();
-    for (const SphereDescription& sphere : body.spheres) {
-      json item = {{"name", sphere.name},
-                   {"center_m", ToJson(sphere.center_m)},
-                   {"radius_m", sphere.radius_m},
-                   {"density_kg_per_m3", sphere.density_kg_per_m3}};
-      if (sphere.foot) item["foot"] = std::string(FootName(*sphere.foot));
-      spheres.push_back(item);
-    }
-    if (!spheres.empty()) entry["spheres"] = spheres;
-    bodies.push_back(entry);
-  }
+  for (const BodyDescription& body : model.bodies) bodies.push_back(BodyToJson(body));
   document["bodies"] = bodies;
   json hinges = json::array();
   for (const HingeDescription& hinge : model.hinges) {
