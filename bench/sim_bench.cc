@@ -7,7 +7,9 @@
 //     MuJoCo needs: it applies the cable damping explicitly), and liftoff at its default
 //     5 ms (the iteration time is then the cost of one simulated second);
 //   - wall time of the full 20-run sweep (RunSweep, all cores) and, for comparison, of the
-//     same 20 experiments in MuJoCo at 1 ms on as many threads.
+//     same 20 experiments in MuJoCo at 1 ms on as many threads;
+//   - the engine's linear solve alone (src/sim/band_cholesky.h) against Eigen's dense LLT
+//     on the mid-run step's system at 5 ms: microseconds per factor and solve.
 // Targets (issue 6): the sweep under 10 s wall; liftoff faster per step than MuJoCo.
 //
 // Run: build/bench/sim_bench   (time per iteration = per step, or per sweep)
@@ -15,11 +17,14 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <thread>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <benchmark/benchmark.h>
 
+#include "band_cholesky.h"
 #include "liftoff/sim/engine.h"
 #include "liftoff/sim/experiment.h"
 #include "liftoff/sim/model.h"
@@ -83,35 +88,105 @@ void CountSteps(benchmark::State& state, double time_step_s, int64_t window_step
   state.counters["dt_ms"] = time_step_s * 1e3;
 }
 
+// Steps `sim` through steps first_step .. last_step with the procedure's commands.
+void Advance(const Model& model, const ExperimentOptions& options, const Procedure& procedure,
+             int64_t first_step, int64_t last_step, State& sim) {
+  Controls controls;
+  controls.rest_length_m.resize(model.cables.size());
+  controls.hinge_angle_rad.resize(1);
+  for (int64_t step = first_step; step <= last_step; ++step) {
+    const double t_s = procedure.TimeAt(step);
+    procedure.RestLengthsAt(t_s, controls.rest_length_m);
+    controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
+    Step(model, options.engine, controls, sim);
+  }
+}
+
 // liftoff's engine: Step with the procedure's commands of the moment.
 void BM_LiftoffStep(benchmark::State& state, double time_step_s) {
   const ExperimentOptions options = BenchOptions(time_step_s);
   const Model model = BenchModel(options);
   const Procedure procedure(model, options);
   State sim = InitialState(model, options.drop_height_m);
-  Controls controls;
-  controls.rest_length_m.resize(model.cables.size());
-  controls.hinge_angle_rad.resize(1);
-  auto advance = [&](int64_t step) {
-    const double t_s = procedure.TimeAt(step);
-    procedure.RestLengthsAt(t_s, controls.rest_length_m);
-    controls.hinge_angle_rad[0] = procedure.HingeAngleAt(t_s);
-    Step(model, options.engine, controls, sim);
-  };
   const int64_t mid_run = std::llround(kMidRunS / time_step_s);
   const int64_t window = std::llround(kWindowS / time_step_s);
-  for (int64_t step = 1; step <= mid_run; ++step) advance(step);
+  Advance(model, options, procedure, 1, mid_run, sim);
   const State saved = sim;
   int contacts = 0;
   for (auto _ : state) {
     sim = saved;
-    for (int64_t step = mid_run + 1; step <= mid_run + window; ++step) advance(step);
+    Advance(model, options, procedure, mid_run + 1, mid_run + window, sim);
     contacts = static_cast<int>(sim.scratch.contacts.size());
     benchmark::DoNotOptimize(sim.bodies.data());
   }
   state.counters["contacts"] = contacts;
   CountSteps(state, time_step_s, window);
 }
+
+// The engine's linear solve on its own: the velocity system of the mid-run step at the
+// default 5 ms (rebuilt from its factor), its band, and as many right-hand sides as the
+// step solves (the free velocity change and one per contact row), seeded.
+struct MidRunSystem {
+  Eigen::MatrixXd matrix;
+  Eigen::Index band = 0;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rhs;
+};
+
+MidRunSystem SystemAtMidRun() {
+  const ExperimentOptions options = BenchOptions(5e-3);
+  const Model model = BenchModel(options);
+  const Procedure procedure(model, options);
+  State sim = InitialState(model, options.drop_height_m);
+  Advance(model, options, procedure, 1, std::llround(kMidRunS / 5e-3), sim);
+  MidRunSystem system;
+  const Eigen::MatrixXd factor = sim.scratch.system.triangularView<Eigen::Lower>();
+  system.matrix = factor * factor.transpose();
+  system.band = sim.scratch.band;
+  int rows = 0;
+  for (const ContactPoint& contact : sim.scratch.contacts) rows += contact.rows;
+  system.rhs.resize(system.matrix.rows(), 1 + rows);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> entry(-1.0, 1.0);
+  for (Eigen::Index i = 0; i < system.rhs.size(); ++i) system.rhs.data()[i] = entry(rng);
+  return system;
+}
+
+void SolveCounters(benchmark::State& state, const MidRunSystem& system) {
+  state.counters["n"] = static_cast<double>(system.matrix.rows());
+  state.counters["band"] = static_cast<double>(system.band);
+  state.counters["rhs"] = static_cast<double>(system.rhs.cols());
+}
+
+// src/sim/band_cholesky.h, as Step uses it: factor in place, solve every column in one pass.
+void BM_BandCholeskySolve(benchmark::State& state) {
+  const MidRunSystem system = SystemAtMidRun();
+  Eigen::MatrixXd work;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> x;
+  for (auto _ : state) {
+    work = system.matrix;
+    x = system.rhs;
+    if (!sim::internal::BandCholesky(work, system.band)) state.SkipWithError("not SPD");
+    sim::internal::BandSolveColumns(work, system.band, x.data(), x.cols(), x.cols());
+    benchmark::DoNotOptimize(x.data());
+  }
+  SolveCounters(state, system);
+}
+BENCHMARK(BM_BandCholeskySolve)->Name("Solve/band_cholesky")->Unit(benchmark::kMicrosecond);
+
+// The same job with Eigen's dense LLT (the library alternative).
+void BM_EigenLltSolve(benchmark::State& state) {
+  const MidRunSystem system = SystemAtMidRun();
+  Eigen::LLT<Eigen::MatrixXd> llt(system.matrix.rows());
+  Eigen::MatrixXd x;
+  const Eigen::MatrixXd rhs = system.rhs;
+  for (auto _ : state) {
+    llt.compute(system.matrix);
+    x = llt.solve(rhs);
+    benchmark::DoNotOptimize(x.data());
+  }
+  SolveCounters(state, system);
+}
+BENCHMARK(BM_EigenLltSolve)->Name("Solve/eigen_llt")->Unit(benchmark::kMicrosecond);
 
 #if LIFTOFF_HAVE_MUJOCO
 // MuJoCo on the exported model: the runner's Step (cable forces, mj_step1, mj_step2).

@@ -470,8 +470,8 @@ std::string HtmlTable(const stats::ResultsTable& table) {
             (row.sim ? HtmlNumber(row.sim->max_rad) : "&ndash;") + "</td><td>" +
             std::to_string(hw.n) + "</td><td>" + HtmlNumber(hw.min) + "</td><td>" +
             HtmlNumber(hw.max) + "</td><td>" + HtmlNumber(hw.mean) + "</td><td>" +
-            HtmlNumber(hw.stddev) + "</td><td>[" + HtmlNumber(hw.ci95_low) + ", " +
-            HtmlNumber(hw.ci95_high) + "]</td></tr>\n";
+            HtmlNumber(hw.stddev) + "</td><td>[" + HtmlNumber(hw.ci_low) + ", " +
+            HtmlNumber(hw.ci_high) + "]</td></tr>\n";
   }
   html += "</table>\n<p>" + EscapeMarkup(table.title) + ", rad; calibration " +
           EscapeMarkup(table.calibration) + "; lookup " + EscapeMarkup(table.lookup_rule) + "</p>\n";

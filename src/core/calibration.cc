@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "liftoff/core/field_checker.h"
 #include "liftoff/core/json.h"
 
 namespace liftoff {
@@ -36,23 +37,6 @@ constexpr NumberRange kGearRatio{.min = 0.01, .max = 1e5};
 constexpr NumberRange kStiffness{.min = 1e-3, .max = 1e7};
 constexpr NumberRange kStiffnessSpread{.min = 0.0, .max = 1e7};
 
-// Collects the first problem, named by the field's JSON pointer in the file format.
-class Checker {
- public:
-  void Number(const std::string& pointer, double value, const NumberRange& range) {
-    if (!InNumberRange(value, range)) {
-      Fail(pointer, "expected " + DescribeNumberRange(range) + ", got " + FormatNumber(value));
-    }
-  }
-  void Fail(const std::string& pointer, const std::string& message) {
-    if (status_.ok()) status_ = InvalidArgumentError(pointer + ": " + message);
-  }
-  Status status() const { return status_; }
-
- private:
-  Status status_;
-};
-
 std::string Index(std::string_view array, size_t i) {
   return std::string(array) + "/" + std::to_string(i);
 }
@@ -62,13 +46,96 @@ std::string Index(std::string_view array, size_t i) {
 // ---------------------------------------------------------------------------------------
 // checks
 
+namespace {
+
+// Calibration::Validate's parts, in the file's order; each records the first problem
+
+void CheckMaterials(const std::vector<MaterialConstant>& materials, FieldChecker& check) {
+  if (materials.empty()) check.Fail("/materials", "expected at least one material");
+  std::set<std::string, std::less<>> names;
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const std::string where = Index("/materials", i);
+    const MaterialConstant& material = materials[i];
+    if (material.name.empty()) check.Fail(where + "/name", "expected a non-empty name");
+    if (!names.insert(material.name).second) {
+      check.Fail(where + "/name", "material \"" + material.name + "\" is listed twice");
+    }
+    check.Number(where + "/stiffness_n_per_m", material.stiffness_n_per_m, kStiffness);
+    check.Number(where + "/stiffness_stddev_n_per_m", material.stiffness_stddev_n_per_m,
+                 kStiffnessSpread);
+  }
+}
+
+// a tension point against the one before: the lattice stiffens with sigma, so both
+// elastomers must rise (or stay) with it
+void CheckTensionOrder(const TensionPoint& point, const TensionPoint& previous,
+                       const std::string& where, FieldChecker& check) {
+  const std::string order = "; tension points run from low to high tension";
+  if (!(point.sigma > previous.sigma)) {
+    check.Fail(where + "/sigma", "expected more than the previous point's " +
+                                     FormatNumber(previous.sigma) + ", got " +
+                                     FormatNumber(point.sigma) + order);
+  }
+  if (point.silicone_n_per_m < previous.silicone_n_per_m) {
+    check.Fail(where + "/silicone_n_per_m", "expected at least the previous point's " +
+                                                FormatNumber(previous.silicone_n_per_m) + ", got " +
+                                                FormatNumber(point.silicone_n_per_m) + order);
+  }
+  if (point.buna_n_n_per_m < previous.buna_n_n_per_m) {
+    check.Fail(where + "/buna_n_n_per_m", "expected at least the previous point's " +
+                                              FormatNumber(previous.buna_n_n_per_m) + ", got " +
+                                              FormatNumber(point.buna_n_n_per_m) + order);
+  }
+}
+
+// tension points: named once each, in order low .. high
+void CheckTensionPoints(const std::vector<TensionPoint>& points, FieldChecker& check) {
+  if (points.empty()) check.Fail("/tension_points", "expected at least one tension point");
+  std::set<std::string, std::less<>> names;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const std::string where = Index("/tension_points", i);
+    const TensionPoint& point = points[i];
+    if (point.name.empty()) check.Fail(where + "/name", "expected a non-empty name");
+    if (!names.insert(point.name).second) {
+      check.Fail(where + "/name", "tension point \"" + point.name + "\" is listed twice");
+    }
+    check.Number(where + "/sigma", point.sigma, kSigma);
+    check.Number(where + "/silicone_n_per_m", point.silicone_n_per_m, kStiffness);
+    check.Number(where + "/buna_n_n_per_m", point.buna_n_n_per_m, kStiffness);
+    check.Number(where + "/spring_n_per_m", point.spring_n_per_m, kStiffness);
+    if (i > 0) CheckTensionOrder(point, points[i - 1], where, check);
+  }
+}
+
+// notes: each names a field of the file format (in `document`) and says something
+void CheckNotes(const std::map<std::string, std::string>& notes, const json& document,
+                FieldChecker& check) {
+  for (const auto& [field, provenance] : notes) {
+    const std::string where = "/notes/" + JsonPointerEscape(field);
+    bool known = false;
+    try {
+      known = field.rfind("/notes", 0) != 0 && document.contains(json::json_pointer(field));
+    } catch (const json::exception&) {
+      known = false;  // not a JSON pointer at all
+    }
+    if (!known) {
+      check.Fail(where,
+                 "expected the JSON pointer of a field of this file, such as "
+                 "\"/motor/gearbox_ratio\"");
+    }
+    if (provenance.empty()) check.Fail(where, "expected a non-empty note");
+  }
+}
+
+}  // namespace
+
 Status Calibration::Validate() const {
-  Checker check;
+  // the first problem, named by the field's JSON pointer in the file format
+  FieldChecker check;
   // name and the drive chain
   if (name.empty()) check.Fail("/name", "expected a non-empty name");
   if (name.find_first_of("\r\n") != std::string::npos) check.Fail("/name", "expected one line");
-  check.Number("/motor/encoder_counts_per_motor_rev", encoder_counts_per_motor_rev,
-               kCountsPerRev);
+  check.Number("/motor/encoder_counts_per_motor_rev", encoder_counts_per_motor_rev, kCountsPerRev);
   check.Number("/motor/gearbox_ratio", gearbox_ratio, kGearRatio);
   check.Number("/rotating_vertebra/spur_gear_ratio", spur_gear_ratio, kGearRatio);
 
@@ -78,76 +145,9 @@ Status Calibration::Validate() const {
     check.Number(Index("/bending_spool/cable_lengths_m", i), cable_lengths_m[i], kCableLength);
   }
 
-  // materials: named once each
-  if (materials.empty()) check.Fail("/materials", "expected at least one material");
-  std::set<std::string, std::less<>> material_names;
-  for (size_t i = 0; i < materials.size(); ++i) {
-    const std::string where = Index("/materials", i);
-    const MaterialConstant& material = materials[i];
-    if (material.name.empty()) check.Fail(where + "/name", "expected a non-empty name");
-    if (!material_names.insert(material.name).second) {
-      check.Fail(where + "/name", "material \"" + material.name + "\" is listed twice");
-    }
-    check.Number(where + "/stiffness_n_per_m", material.stiffness_n_per_m, kStiffness);
-    check.Number(where + "/stiffness_stddev_n_per_m", material.stiffness_stddev_n_per_m,
-                 kStiffnessSpread);
-  }
-
-  // tension points: named once each, in order low .. high
-  if (tension_points.empty()) check.Fail("/tension_points", "expected at least one tension point");
-  std::set<std::string, std::less<>> point_names;
-  for (size_t i = 0; i < tension_points.size(); ++i) {
-    const std::string where = Index("/tension_points", i);
-    const TensionPoint& point = tension_points[i];
-    if (point.name.empty()) check.Fail(where + "/name", "expected a non-empty name");
-    if (!point_names.insert(point.name).second) {
-      check.Fail(where + "/name", "tension point \"" + point.name + "\" is listed twice");
-    }
-    check.Number(where + "/sigma", point.sigma, kSigma);
-    check.Number(where + "/silicone_n_per_m", point.silicone_n_per_m, kStiffness);
-    check.Number(where + "/buna_n_n_per_m", point.buna_n_n_per_m, kStiffness);
-    check.Number(where + "/spring_n_per_m", point.spring_n_per_m, kStiffness);
-    if (i == 0) continue;
-    // the lattice stiffens with sigma, so both elastomers must rise (or stay) with it
-    const TensionPoint& previous = tension_points[i - 1];
-    const std::string order = "; tension points run from low to high tension";
-    if (!(point.sigma > previous.sigma)) {
-      check.Fail(where + "/sigma", "expected more than the previous point's " +
-                                       FormatNumber(previous.sigma) + ", got " +
-                                       FormatNumber(point.sigma) + order);
-    }
-    if (point.silicone_n_per_m < previous.silicone_n_per_m) {
-      check.Fail(where + "/silicone_n_per_m", "expected at least the previous point's " +
-                                                  FormatNumber(previous.silicone_n_per_m) +
-                                                  ", got " + FormatNumber(point.silicone_n_per_m) +
-                                                  order);
-    }
-    if (point.buna_n_n_per_m < previous.buna_n_n_per_m) {
-      check.Fail(where + "/buna_n_n_per_m", "expected at least the previous point's " +
-                                                FormatNumber(previous.buna_n_n_per_m) + ", got " +
-                                                FormatNumber(point.buna_n_n_per_m) + order);
-    }
-  }
-
-  // notes: each names a field of the file format and says something
-  if (!notes.empty() && check.status().ok()) {
-    const json document = CalibrationToJson(*this);
-    for (const auto& [field, provenance] : notes) {
-      const std::string where = "/notes/" + JsonPointerEscape(field);
-      bool known = false;
-      try {
-        known = field.rfind("/notes", 0) != 0 && document.contains(json::json_pointer(field));
-      } catch (const json::exception&) {
-        known = false;  // not a JSON pointer at all
-      }
-      if (!known) {
-        check.Fail(where,
-                   "expected the JSON pointer of a field of this file, such as "
-                   "\"/motor/gearbox_ratio\"");
-      }
-      if (provenance.empty()) check.Fail(where, "expected a non-empty note");
-    }
-  }
+  CheckMaterials(materials, check);
+  CheckTensionPoints(tension_points, check);
+  if (!notes.empty() && check.ok()) CheckNotes(notes, CalibrationToJson(*this), check);
   return check.status();
 }
 

@@ -7,10 +7,17 @@
 #include <limits>
 
 #include "liftoff/core/json.h"
+#include "band_cholesky.h"
+#include "contact_solver.h"
+#include "segments.h"
 
 namespace liftoff::sim {
 namespace {
 
+using internal::BandCholesky;
+using internal::BandSolveColumns;
+using internal::ClosestPointsOfSegments;
+using internal::SolveContactImpulses;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
@@ -36,46 +43,6 @@ Mat3 Skew(const Vec3& v) {
 
 size_t Index(int i) { return static_cast<size_t>(i); }
 
-// Closest points of segments p1-q1 and p2-q2 (Ericson, Real-Time Collision Detection 5.1.9).
-void ClosestPointsOfSegments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
-                             Vec3& c1, Vec3& c2) {
-  const Vec3 d1 = q1 - p1;
-  const Vec3 d2 = q2 - p2;
-  const Vec3 r = p1 - p2;
-  const double a = d1.squaredNorm();
-  const double e = d2.squaredNorm();
-  const double f = d2.dot(r);
-  double s = 0.0;
-  double t = 0.0;
-  if (a <= 1e-18 && e <= 1e-18) {
-    c1 = p1;
-    c2 = p2;
-    return;
-  }
-  if (a <= 1e-18) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= 1e-18) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2);
-      const double denominator = a * e - b * b;
-      s = denominator > 1e-18 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0.0) {
-        t = 0.0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-      } else if (t > 1.0) {
-        t = 1.0;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-      }
-    }
-  }
-  c1 = p1 + d1 * s;
-  c2 = p2 + d2 * t;
-}
-
 // system(at + i, at + j) += weight a_i a_j for j <= i (the lower triangle of a block on
 // the diagonal).
 void AddLowerOuter(Eigen::MatrixXd& system, Eigen::Index at, const Vec6& a, double weight) {
@@ -91,57 +58,6 @@ void AddOuter(Eigen::MatrixXd& system, Eigen::Index row, Eigen::Index col, const
   for (Eigen::Index j = 0; j < 6; ++j) {
     const double scaled = weight * b[j];
     for (Eigen::Index i = 0; i < 6; ++i) system(row + i, col + j) += scaled * a[i];
-  }
-}
-
-// In-place Cholesky factor (lower triangle) of a symmetric positive definite matrix whose
-// lower triangle is zero more than `band` below the diagonal; the factor keeps the band.
-// Only the lower triangle is read or written. Returns false if it is not positive definite.
-bool BandCholesky(Eigen::MatrixXd& a, Eigen::Index band) {
-  const Eigen::Index n = a.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double diagonal = a(k, k);
-    if (!(diagonal > 0.0)) return false;
-    const double pivot = std::sqrt(diagonal);
-    a(k, k) = pivot;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    const double inverse = 1.0 / pivot;
-    for (Eigen::Index i = k + 1; i < end; ++i) a(i, k) *= inverse;
-    for (Eigen::Index j = k + 1; j < end; ++j) {
-      const double factor = a(j, k);
-      if (factor == 0.0) continue;
-      for (Eigen::Index i = j; i < end; ++i) a(i, j) -= a(i, k) * factor;
-    }
-  }
-  return true;
-}
-
-// Solves (L L^T) X = B in place with the factor of BandCholesky, for the first `columns`
-// columns of a row-major X (rows of `stride` numbers): the columns share every pass.
-void BandSolveColumns(const Eigen::MatrixXd& l, Eigen::Index band, double* x, Eigen::Index stride,
-                      Eigen::Index columns) {
-  const Eigen::Index n = l.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    double* xk = x + k * stride;
-    const double inverse = 1.0 / l(k, k);
-    for (Eigen::Index c = 0; c < columns; ++c) xk[c] *= inverse;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    for (Eigen::Index i = k + 1; i < end; ++i) {
-      const double factor = l(i, k);
-      double* xi = x + i * stride;
-      for (Eigen::Index c = 0; c < columns; ++c) xi[c] -= factor * xk[c];
-    }
-  }
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    double* xk = x + k * stride;
-    const Eigen::Index end = std::min(n, k + band + 1);
-    for (Eigen::Index i = k + 1; i < end; ++i) {
-      const double factor = l(i, k);
-      const double* xi = x + i * stride;
-      for (Eigen::Index c = 0; c < columns; ++c) xk[c] -= factor * xi[c];
-    }
-    const double inverse = 1.0 / l(k, k);
-    for (Eigen::Index c = 0; c < columns; ++c) xk[c] *= inverse;
   }
 }
 
@@ -291,100 +207,115 @@ void AddGroundContact(int64_t key, int body, const Vec3& lowest_point, double fr
   contacts.push_back(contact);
 }
 
-// Every contact within the margin, in a fixed order.
-void FindContacts(const Model& model, const EngineOptions& options, State& state) {
-  StepScratch& scratch = state.scratch;
-  std::vector<ContactPoint>& contacts = scratch.contacts;
-  contacts.clear();
+// One body's contacts with the ground: its feet (and, with spine_ground, its other
+// spheres, its colliding rods' end spheres and its boxes' corners).
+void FindGroundContacts(const Model& model, const EngineOptions& options, const State& state,
+                        size_t b, std::vector<ContactPoint>& contacts) {
   const double friction = model.contact.friction;
   const double spine_friction = model.contact.spine_friction.value_or(friction);
   const double margin = options.contact_margin_m;
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const Body& body = model.bodies[b];
-    const BodyState& pose = state.bodies[b];
-    const Mat3& rotation = scratch.rotation[b];
-    const int body_index = static_cast<int>(b);
-    for (size_t s = 0; s < body.spheres.size(); ++s) {
-      const Sphere& sphere = body.spheres[s];
-      const bool foot = sphere.foot_index >= 0;
-      if (!foot && !model.contact.spine_ground) continue;
-      const Vec3 center = pose.position_m + rotation * sphere.center_m;
-      AddGroundContact(
-          ContactKey(foot ? kFootKind : kSphereKind, body_index, static_cast<int64_t>(s), 0),
-          body_index, center - Vec3(0.0, 0.0, sphere.radius_m), foot ? friction : spine_friction,
-          sphere.foot_index, margin, contacts);
-    }
-    if (!model.contact.spine_ground) continue;
-    // rods as capsules: their lowest points are on the end spheres
-    for (size_t r = 0; r < body.rods.size(); ++r) {
-      const Rod& rod = body.rods[r];
-      if (!rod.collides) continue;
-      const Vec3 ends[2] = {pose.position_m + rotation * rod.from_m,
-                            pose.position_m + rotation * rod.to_m};
-      for (int e = 0; e < 2; ++e) {
-        AddGroundContact(ContactKey(kRodEndKind, body_index, static_cast<int64_t>(r), e),
-                         body_index, ends[e] - Vec3(0.0, 0.0, rod.radius_m), spine_friction, -1,
-                         margin, contacts);
-      }
-    }
-    for (size_t x = 0; x < body.boxes.size(); ++x) {
-      const Box& box = body.boxes[x];
-      if (!box.collides) continue;
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
-                        (corner & 4) ? 1.0 : -1.0);
-        const Vec3 point =
-            pose.position_m + rotation * (box.center_m + sign.cwiseProduct(box.half_size_m));
-        AddGroundContact(ContactKey(kBoxCornerKind, body_index, static_cast<int64_t>(x), corner),
-                         body_index, point, spine_friction, -1, margin, contacts);
-      }
+  const Body& body = model.bodies[b];
+  const BodyState& pose = state.bodies[b];
+  const Mat3& rotation = state.scratch.rotation[b];
+  const int body_index = static_cast<int>(b);
+  for (size_t s = 0; s < body.spheres.size(); ++s) {
+    const Sphere& sphere = body.spheres[s];
+    const bool foot = sphere.foot_index >= 0;
+    if (!foot && !model.contact.spine_ground) continue;
+    const Vec3 center = pose.position_m + rotation * sphere.center_m;
+    AddGroundContact(
+        ContactKey(foot ? kFootKind : kSphereKind, body_index, static_cast<int64_t>(s), 0),
+        body_index, center - Vec3(0.0, 0.0, sphere.radius_m), foot ? friction : spine_friction,
+        sphere.foot_index, margin, contacts);
+  }
+  if (!model.contact.spine_ground) return;
+  // rods as capsules: their lowest points are on the end spheres
+  for (size_t r = 0; r < body.rods.size(); ++r) {
+    const Rod& rod = body.rods[r];
+    if (!rod.collides) continue;
+    const Vec3 ends[2] = {pose.position_m + rotation * rod.from_m,
+                          pose.position_m + rotation * rod.to_m};
+    for (int e = 0; e < 2; ++e) {
+      AddGroundContact(ContactKey(kRodEndKind, body_index, static_cast<int64_t>(r), e), body_index,
+                       ends[e] - Vec3(0.0, 0.0, rod.radius_m), spine_friction, -1, margin,
+                       contacts);
     }
   }
+  for (size_t x = 0; x < body.boxes.size(); ++x) {
+    const Box& box = body.boxes[x];
+    if (!box.collides) continue;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
+                      (corner & 4) ? 1.0 : -1.0);
+      const Vec3 point =
+          pose.position_m + rotation * (box.center_m + sign.cwiseProduct(box.half_size_m));
+      AddGroundContact(ContactKey(kBoxCornerKind, body_index, static_cast<int64_t>(x), corner),
+                       body_index, point, spine_friction, -1, margin, contacts);
+    }
+  }
+}
+
+// The contacts between the colliding rods of bodies b1 and b2 (capsules), unless their
+// rods' bounding spheres are apart by more than the margin.
+void FindRodPairContacts(const Model& model, const EngineOptions& options, const State& state,
+                         size_t b1, size_t b2, std::vector<ContactPoint>& contacts) {
+  const StepScratch& scratch = state.scratch;
+  const double margin = options.contact_margin_m;
+  const double spine_friction = model.contact.spine_friction.value_or(model.contact.friction);
+  if (scratch.rod_bound_radius[b1] < 0.0 || scratch.rod_bound_radius[b2] < 0.0) return;
+  const Vec3 center1 =
+      state.bodies[b1].position_m + scratch.rotation[b1] * scratch.rod_bound_center[b1];
+  const Vec3 center2 =
+      state.bodies[b2].position_m + scratch.rotation[b2] * scratch.rod_bound_center[b2];
+  const double reach = scratch.rod_bound_radius[b1] + scratch.rod_bound_radius[b2] + margin;
+  if ((center1 - center2).squaredNorm() > reach * reach) return;
+  const Body& body1 = model.bodies[b1];
+  const Body& body2 = model.bodies[b2];
+  for (size_t r1 = 0; r1 < body1.rods.size(); ++r1) {
+    const Rod& rod1 = body1.rods[r1];
+    if (!rod1.collides) continue;
+    const Vec3 p1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.from_m;
+    const Vec3 q1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.to_m;
+    for (size_t r2 = 0; r2 < body2.rods.size(); ++r2) {
+      const Rod& rod2 = body2.rods[r2];
+      if (!rod2.collides) continue;
+      const Vec3 p2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.from_m;
+      const Vec3 q2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.to_m;
+      Vec3 c1;
+      Vec3 c2;
+      ClosestPointsOfSegments(p1, q1, p2, q2, c1, c2);
+      const Vec3 between = c2 - c1;
+      const double distance = between.norm();
+      const double gap = distance - rod1.radius_m - rod2.radius_m;
+      if (gap > margin || distance < 1e-12) continue;
+      ContactPoint contact;
+      contact.key = ContactKey(kRodPairKind, static_cast<int64_t>(b1 * 256 + b2),
+                               static_cast<int64_t>(r1), static_cast<int64_t>(r2));
+      contact.body_a = static_cast<int>(b1);
+      contact.body_b = static_cast<int>(b2);
+      contact.normal = between / distance;
+      contact.point_a_m = c1 + contact.normal * rod1.radius_m;
+      contact.point_b_m = c2 - contact.normal * rod2.radius_m;
+      contact.gap_m = gap;
+      contact.friction = spine_friction;
+      contacts.push_back(contact);
+    }
+  }
+}
+
+// Every contact within the margin, in a fixed order: each body's with the ground, then
+// (with spine_self) those between the rods of bodies that move independently.
+void FindContacts(const Model& model, const EngineOptions& options, State& state) {
+  std::vector<ContactPoint>& contacts = state.scratch.contacts;
+  contacts.clear();
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    FindGroundContacts(model, options, state, b, contacts);
+  }
   if (!model.contact.spine_self) return;
-  // rods of bodies that move independently, as capsules; bodies whose rods' bounding
-  // spheres are apart by more than the margin are skipped
   for (size_t b1 = 0; b1 < model.bodies.size(); ++b1) {
     for (size_t b2 = b1 + 1; b2 < model.bodies.size(); ++b2) {
-      if (scratch.cluster_of_body[b1] == scratch.cluster_of_body[b2]) continue;
-      if (scratch.rod_bound_radius[b1] < 0.0 || scratch.rod_bound_radius[b2] < 0.0) continue;
-      const Vec3 center1 =
-          state.bodies[b1].position_m + scratch.rotation[b1] * scratch.rod_bound_center[b1];
-      const Vec3 center2 =
-          state.bodies[b2].position_m + scratch.rotation[b2] * scratch.rod_bound_center[b2];
-      const double reach = scratch.rod_bound_radius[b1] + scratch.rod_bound_radius[b2] + margin;
-      if ((center1 - center2).squaredNorm() > reach * reach) continue;
-      const Body& body1 = model.bodies[b1];
-      const Body& body2 = model.bodies[b2];
-      for (size_t r1 = 0; r1 < body1.rods.size(); ++r1) {
-        const Rod& rod1 = body1.rods[r1];
-        if (!rod1.collides) continue;
-        const Vec3 p1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.from_m;
-        const Vec3 q1 = state.bodies[b1].position_m + scratch.rotation[b1] * rod1.to_m;
-        for (size_t r2 = 0; r2 < body2.rods.size(); ++r2) {
-          const Rod& rod2 = body2.rods[r2];
-          if (!rod2.collides) continue;
-          const Vec3 p2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.from_m;
-          const Vec3 q2 = state.bodies[b2].position_m + scratch.rotation[b2] * rod2.to_m;
-          Vec3 c1;
-          Vec3 c2;
-          ClosestPointsOfSegments(p1, q1, p2, q2, c1, c2);
-          const Vec3 between = c2 - c1;
-          const double distance = between.norm();
-          const double gap = distance - rod1.radius_m - rod2.radius_m;
-          if (gap > margin || distance < 1e-12) continue;
-          ContactPoint contact;
-          contact.key = ContactKey(kRodPairKind, static_cast<int64_t>(b1 * 256 + b2),
-                                   static_cast<int64_t>(r1), static_cast<int64_t>(r2));
-          contact.body_a = static_cast<int>(b1);
-          contact.body_b = static_cast<int>(b2);
-          contact.normal = between / distance;
-          contact.point_a_m = c1 + contact.normal * rod1.radius_m;
-          contact.point_b_m = c2 - contact.normal * rod2.radius_m;
-          contact.gap_m = gap;
-          contact.friction = spine_friction;
-          contacts.push_back(contact);
-        }
-      }
+      if (state.scratch.cluster_of_body[b1] == state.scratch.cluster_of_body[b2]) continue;
+      FindRodPairContacts(model, options, state, b1, b2, contacts);
     }
   }
 }
@@ -517,37 +448,8 @@ void SolveContacts(const EngineOptions& options, State& state, int rows) {
   }
 
   // projected Gauss-Seidel
-  for (int sweep = 0; sweep < options.solver_iterations; ++sweep) {
-    double largest_change = 0.0;
-    for (const ContactPoint& contact : contacts) {
-      const int n = contact.first_row;
-      const double normal_velocity = scratch.row_velocity[n] + w.row(n).dot(impulse);
-      const double updated = std::max(
-          0.0, impulse[n] + (contact.target_normal_velocity_m_per_s - normal_velocity) / w(n, n));
-      largest_change = std::max(largest_change, std::abs(updated - impulse[n]));
-      impulse[n] = updated;
-      if (contact.rows == 1) continue;
-      double t[2];
-      for (int k = 0; k < 2; ++k) {
-        const int row = n + 1 + k;
-        const double tangent_velocity = scratch.row_velocity[row] + w.row(row).dot(impulse);
-        t[k] = impulse[row] - tangent_velocity / w(row, row);
-      }
-      // Coulomb: inside the cone of the current normal impulse
-      const double limit = contact.friction * impulse[n];
-      const double magnitude = std::hypot(t[0], t[1]);
-      if (magnitude > limit) {
-        const double scale = magnitude > 0.0 ? limit / magnitude : 0.0;
-        t[0] *= scale;
-        t[1] *= scale;
-      }
-      for (int k = 0; k < 2; ++k) {
-        largest_change = std::max(largest_change, std::abs(t[k] - impulse[n + 1 + k]));
-        impulse[n + 1 + k] = t[k];
-      }
-    }
-    if (largest_change <= options.solver_tolerance_n_s) break;
-  }
+  SolveContactImpulses(contacts, w, scratch.row_velocity, options.solver_iterations,
+                       options.solver_tolerance_n_s, impulse);
   scratch.velocity.noalias() += y * impulse;
 
   // remember for the next step

@@ -136,9 +136,9 @@ Result<std::string> RenderResultsPlotSvg(const ResultsTable& table, const PlotOp
     const Summary& hw = row->hardware;
     if (hw.n > 0 && std::isfinite(hw.mean)) {
       const double x = trials_x - (count + 1) / 2 * 6.0 - 14;
-      if (std::isfinite(hw.ci95_low) && std::isfinite(hw.ci95_high)) {
+      if (std::isfinite(hw.ci_low) && std::isfinite(hw.ci_high)) {
         svg << R"(<line x1=")" << Px(x) << R"(" x2=")" << Px(x) << R"(" y1=")"
-            << Px(y_of(hw.ci95_low)) << R"(" y2=")" << Px(y_of(hw.ci95_high))
+            << Px(y_of(hw.ci_low)) << R"(" y2=")" << Px(y_of(hw.ci_high))
             << R"(" stroke="black"/>)" << '\n';
       }
       svg << R"(<line x1=")" << Px(x - 7) << R"(" x2=")" << Px(x + 7) << R"(" y1=")"

@@ -28,8 +28,7 @@ std::string Summary::Brief() const {
   if (n > 1) {
     char level[16];
     std::snprintf(level, sizeof level, "%g", confidence * 100.0);
-    text +=
-        ", " + std::string(level) + " % CI [" + Format(ci95_low) + ", " + Format(ci95_high) + "]";
+    text += ", " + std::string(level) + " % CI [" + Format(ci_low) + ", " + Format(ci_high) + "]";
   }
   text += ", range [" + Format(min) + ", " + Format(max) + "]";
   return text;
@@ -79,8 +78,8 @@ Summary Summarize(std::span<const double> values, double confidence) {
   const double t = StudentTQuantile(0.5 * (1.0 + confidence), static_cast<double>(count - 1));
   if (std::isfinite(t)) {
     const double half_width = t * summary.stddev / std::sqrt(static_cast<double>(count));
-    summary.ci95_low = summary.mean - half_width;
-    summary.ci95_high = summary.mean + half_width;
+    summary.ci_low = summary.mean - half_width;
+    summary.ci_high = summary.mean + half_width;
   }
   return summary;
 }

@@ -179,7 +179,8 @@ ResultsTable BuildResultsTable(std::span<const TrialValue> trials, const SimResu
       row.trials.push_back(trial);
       values.push_back(trial.liftoff_rad);
     }
-    row.hardware = Summarize(values);
+    // at 95 %, the level the table's ci95_* columns and keys name
+    row.hardware = Summarize(values, 0.95);
     if (sim != nullptr) {
       if (auto it = sim->ranges.find(foot); it != sim->ranges.end()) row.sim = it->second;
     }
@@ -257,8 +258,8 @@ json ResultsTableToJson(const ResultsTable& table) {
                       {"mean_rad", NumberOrNull(hw.mean)},
                       {"stddev_rad", NumberOrNull(hw.stddev)},
                       {"median_rad", NumberOrNull(hw.median)},
-                      {"ci95_low_rad", NumberOrNull(hw.ci95_low)},
-                      {"ci95_high_rad", NumberOrNull(hw.ci95_high)},
+                      {"ci95_low_rad", NumberOrNull(hw.ci_low)},
+                      {"ci95_high_rad", NumberOrNull(hw.ci_high)},
                       {"confidence", hw.confidence}}},
                     {"trials", std::move(trials)}});
   }
@@ -287,12 +288,12 @@ std::string RenderResultsTable(const ResultsTable& table, TableFormat format) {
       cells.push_back(std::move(cell));
     }
     if (csv) {
-      for (Cell cell : {Fixed3(hw.ci95_low), Fixed3(hw.ci95_high), Cell(table.calibration),
+      for (Cell cell : {Fixed3(hw.ci_low), Fixed3(hw.ci_high), Cell(table.calibration),
                         Cell(table.lookup_rule)}) {
         cells.push_back(std::move(cell));
       }
     } else {
-      cells.push_back(Interval(hw.ci95_low, hw.ci95_high));
+      cells.push_back(Interval(hw.ci_low, hw.ci_high));
     }
     rows.push_back(std::move(cells));
   }

@@ -191,6 +191,8 @@ Result<ItemOutput> WriteInvalidItem(const InvalidInput& input, const Calibration
 
 }  // namespace
 
+// Long on purpose: a table of the set's clips, one block each, read top to bottom like
+// docs/synth.md's list of them.
 std::vector<TrialSpec> CiSet() {
   std::vector<TrialSpec> set;
   const auto add = [&](TrialSpec spec) { set.push_back(Finish(std::move(spec))); };

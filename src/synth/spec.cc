@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "liftoff/core/field_checker.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 
@@ -28,49 +29,13 @@ constexpr double kPi = std::numbers::pi;
 
 NumberRange Closed(double min, double max) { return {.min = min, .max = max}; }
 
-// Keeps the first problem as (field path, message).
-class Checker {
- public:
-  void Number(std::string_view field, double value, const NumberRange& range) {
-    if (!InNumberRange(value, range)) {
-      Fail(field, "expected " + DescribeNumberRange(range, false) + ", got " + FormatNumber(value));
-    }
-  }
-  void Integer(std::string_view field, double value, const NumberRange& range) {
-    if (!InNumberRange(value, range)) {
-      Fail(field, "expected " + DescribeNumberRange(range, true) + ", got " + FormatNumber(value));
-    }
-  }
-  void Fail(std::string_view field, std::string message) {
-    if (field_.empty()) {
-      field_ = field;
-      message_ = std::move(message);
-    }
-  }
-  bool ok() const { return field_.empty(); }
-  const std::string& field() const { return field_; }
-  const std::string& message() const { return message_; }
-
- private:
-  std::string field_, message_;
-};
-
 bool IsIdCharacter(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
          c == '_' || c == '-';
 }
 
-void CheckSpec(const TrialSpec& spec, Checker& check) {
-  // the trial
-  if (spec.id.empty() || spec.id.size() > 100 || spec.id.front() == '.' ||
-      !std::all_of(spec.id.begin(), spec.id.end(), IsIdCharacter)) {
-    check.Fail("id", "expected 1 to 100 of A-Z a-z 0-9 . _ - (not starting with '.'), got \"" +
-                         spec.id + "\"");
-  }
-  check.Number("duration_s", spec.duration_s, {.min = 0, .max = 3600, .min_exclusive = true});
-
-  // camera
-  const CameraSpec& camera = spec.camera;
+// the camera: frame size, rate, exposure, drops, codec quality
+void CheckCamera(const CameraSpec& camera, FieldChecker& check) {
   check.Integer("camera.width_px", camera.width_px, Closed(320, 1920));
   check.Integer("camera.height_px", camera.height_px, Closed(240, 1080));
   if (camera.width_px % 2 != 0) {
@@ -95,9 +60,10 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
   } else if (camera.codec == VideoCodec::kMjpeg) {
     check.Integer("camera.quality", camera.quality, Closed(2, 31));
   }
+}
 
-  // nuisances
-  const NuisanceSpec& nuisance = spec.nuisance;
+// the nuisances: noise, blur, flicker, shake
+void CheckNuisance(const NuisanceSpec& nuisance, FieldChecker& check) {
   check.Number("nuisance.noise_sigma", nuisance.noise_sigma, Closed(0, 30));
   check.Integer("nuisance.motion_blur_samples", nuisance.motion_blur_samples, Closed(1, 16));
   check.Number("nuisance.flicker_amplitude", nuisance.flicker_amplitude, Closed(0, 0.5));
@@ -106,9 +72,10 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
                "expected 100 or 120 (50 or 60 Hz mains), got " + FormatNumber(nuisance.flicker_hz));
   }
   check.Number("nuisance.shake_px", nuisance.shake_px, Closed(0, 2));
+}
 
-  // the LED
-  const LedSpec& led = spec.led;
+// the LED: place, size, colour, brightness, switch-on
+void CheckLed(const LedSpec& led, FieldChecker& check) {
   check.Number("led.x_frac", led.x_frac, Closed(0, 1));
   check.Number("led.y_frac", led.y_frac, Closed(0, 1));
   check.Number("led.radius_px", led.radius_px, Closed(1, 40));
@@ -118,9 +85,10 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
   check.Number("led.intensity", led.intensity, Closed(0.1, 4));
   check.Number("led.bloom", led.bloom, Closed(0, 6));
   check.Number("led.on_video_s", led.on_video_s, Closed(-3600, 7200));
+}
 
-  // the motion
-  const MotionSpec& motion = spec.motion;
+// the motion: the height curve, bend and ramp
+void CheckMotion(const MotionSpec& motion, FieldChecker& check) {
   const HeightCurveSpec& height = motion.height;
   if (height.kind == "parametric") {
     check.Number("motion.height.liftoff_rad", height.liftoff_rad, Closed(0, kPi));
@@ -148,9 +116,10 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
   check.Number("motion.ramp_rate_rad_per_s", motion.ramp_rate_rad_per_s,
                {.min = 0, .max = 10, .min_exclusive = true});
   check.Number("motion.diagonal_lag_rad", motion.diagonal_lag_rad, Closed(-kPi, kPi));
+}
 
-  // the log
-  const LogSpec& log = spec.log;
+// the controller log: LED event, clock, rate, bursts, margins
+void CheckLog(const LogSpec& log, FieldChecker& check) {
   check.Integer("log.led_on_device_ns", static_cast<double>(log.led_on_device_ns), Closed(0, 1e15));
   if (!log.led_event && log.led_on_device_ns != 0) {
     check.Fail("log.led_on_device_ns",
@@ -168,6 +137,21 @@ void CheckSpec(const TrialSpec& spec, Checker& check) {
   }
   check.Number("log.lead_s", log.lead_s, Closed(0, 60));
   check.Number("log.tail_s", log.tail_s, Closed(0, 60));
+}
+
+void CheckSpec(const TrialSpec& spec, FieldChecker& check) {
+  // the trial
+  if (spec.id.empty() || spec.id.size() > 100 || spec.id.front() == '.' ||
+      !std::all_of(spec.id.begin(), spec.id.end(), IsIdCharacter)) {
+    check.Fail("id", "expected 1 to 100 of A-Z a-z 0-9 . _ - (not starting with '.'), got \"" +
+                         spec.id + "\"");
+  }
+  check.Number("duration_s", spec.duration_s, {.min = 0, .max = 3600, .min_exclusive = true});
+  CheckCamera(spec.camera, check);
+  CheckNuisance(spec.nuisance, check);
+  CheckLed(spec.led, check);
+  CheckMotion(spec.motion, check);
+  CheckLog(spec.log, check);
 }
 
 // The JSON pointer of a struct field path: "camera.fps" -> "/camera/fps".
@@ -372,10 +356,9 @@ std::string_view VideoCodecExtension(VideoCodec codec) {
 // trial specs
 
 Status TrialSpec::Validate() const {
-  Checker check;
+  FieldChecker check;
   CheckSpec(*this, check);
-  if (check.ok()) return Status::Ok();
-  return InvalidArgumentError(check.field() + ": " + check.message());
+  return check.status();
 }
 
 Result<TrialSpec> TrialSpecFromJson(const json& document, const std::string& source,
@@ -491,7 +474,7 @@ Result<TrialSpec> TrialSpecFromJson(const json& document, const std::string& sou
   LIFTOFF_RETURN_IF_ERROR(root.Finish());
 
   // values: the same checks as Validate(), named by JSON pointer
-  Checker check;
+  FieldChecker check;
   CheckSpec(spec, check);
   if (!check.ok()) {
     return InvalidArgumentError(source + ": " + JsonPointerOfField(check.field()) + ": " +

@@ -630,6 +630,7 @@ Trial3dSpec& AddToSet(std::vector<Trial3dSpec>& set, const std::string& id, uint
 
 }  // namespace
 
+// Long on purpose: a table of the set's clips, one block each.
 std::vector<Trial3dSpec> Ci3dSet() {
   std::vector<Trial3dSpec> set;
   const auto add = [&](const std::string& id, uint64_t seed) -> Trial3dSpec& {
@@ -724,6 +725,7 @@ std::vector<Trial3dSpec> Ci3dSet() {
   return set;
 }
 
+// Long on purpose: a table of the set's clips, one block each.
 std::vector<Trial3dSpec> Hard3dSet() {
   std::vector<Trial3dSpec> set;
   const auto add = [&](const std::string& id, uint64_t seed) -> Trial3dSpec& {

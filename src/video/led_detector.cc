@@ -1,9 +1,5 @@
 #include "liftoff/video/led_detector.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +11,7 @@
 
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
+#include "cell_sums.h"
 #include "led_timing.h"
 #include "video_util.h"
 
@@ -22,8 +19,10 @@ namespace liftoff::video {
 namespace {
 
 using internal::ExposureRange;
+using Grid = internal::CellGrid;
 using internal::InstantInterval;
 using internal::LitFraction;
+using internal::MeasureCells;
 using internal::MedianOf;
 using internal::RectText;
 
@@ -66,9 +65,9 @@ constexpr int kConfirmFrames = 8;
 // kGainMinLevels grey levels are left out).
 constexpr double kReferenceFrames = 64.0;
 constexpr double kGainMinLevels = 10.0;
-// Automatic locating samples every other row; the gain uses every other cell column and
-// row. With an ROI, the frame-wide statistics use every kReferenceStride-th cell.
-constexpr int kAutoRowStep = 2;
+// Automatic locating samples every other row (internal::kCellRowStep); the gain uses every
+// other cell column and row. With an ROI, the frame-wide statistics use every
+// kReferenceStride-th cell.
 constexpr int kGainStride = 2;
 constexpr int kReferenceStride = 4;
 // A measured fraction of the exposure is known to within max(sigmas * its noise, margin)
@@ -180,96 +179,6 @@ WindowShape ShapeOf(const double* values, int before_count, int after_count, boo
     shape.after_creep = std::max(shape.after_creep, along - least);
   }
   return shape;
-}
-
-// The cells of the automatic locator: origins of every cell column and row (the last one
-// flush with the frame's edge, so the whole frame is covered).
-struct Grid {
-  int cell_px = 16;
-  int columns = 0, rows = 0;
-  std::vector<int> x0_px, y0_px;
-  int sampled_px_per_cell = 0;
-
-  // every `stride`-th cell of the full grid
-  static Grid Make(int width_px, int height_px, int cell_px, int stride) {
-    Grid grid;
-    grid.cell_px = cell_px;
-    const int columns = (width_px + cell_px - 1) / cell_px;
-    const int rows = (height_px + cell_px - 1) / cell_px;
-    for (int i = 0; i < columns; i += stride) {
-      grid.x0_px.push_back(std::min(i * cell_px, width_px - cell_px));
-    }
-    for (int i = 0; i < rows; i += stride) {
-      grid.y0_px.push_back(std::min(i * cell_px, height_px - cell_px));
-    }
-    grid.columns = static_cast<int>(grid.x0_px.size());
-    grid.rows = static_cast<int>(grid.y0_px.size());
-    grid.sampled_px_per_cell = cell_px * ((cell_px + kAutoRowStep - 1) / kAutoRowStep);
-    return grid;
-  }
-  int cells() const { return columns * rows; }
-};
-
-#if defined(__SSE2__)
-// one cell at a time, its sampled rows 16 bytes per instruction, the sum and the
-// maximum kept in registers
-void MeasureCellsSse2(const cv::Mat& bgr, const Grid& grid, float* sums, uint8_t* peaks) {
-  const int chunks = grid.cell_px * 3 / 16;
-  const size_t row_stride = bgr.step[0] * static_cast<size_t>(kAutoRowStep);
-  const __m128i zero = _mm_setzero_si128();
-  for (int row = 0; row < grid.rows; ++row) {
-    const uint8_t* band = bgr.ptr<uint8_t>(grid.y0_px[static_cast<size_t>(row)]);
-    for (int column = 0; column < grid.columns; ++column) {
-      __m128i sum = zero, peak = zero;
-      const uint8_t* line = band + grid.x0_px[static_cast<size_t>(column)] * 3;
-      for (int y = 0; y < grid.cell_px; y += kAutoRowStep, line += row_stride) {
-        for (int chunk = 0; chunk < chunks; ++chunk) {
-          __m128i value;
-          std::memcpy(&value, line + 16 * chunk, sizeof value);
-          sum = _mm_add_epi64(sum, _mm_sad_epu8(value, zero));
-          peak = _mm_max_epu8(peak, value);
-        }
-      }
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 8));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 4));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 2));
-      peak = _mm_max_epu8(peak, _mm_srli_si128(peak, 1));
-      std::array<uint64_t, 2> halves{};
-      std::memcpy(halves.data(), &sum, sizeof halves);
-      const auto cell = static_cast<size_t>(row * grid.columns + column);
-      sums[cell] = static_cast<float>(halves[0] + halves[1]);
-      peaks[cell] = static_cast<uint8_t>(_mm_cvtsi128_si32(peak) & 0xff);
-    }
-  }
-}
-#endif
-
-// Sum of B + G + R and the brightest channel value of every cell, every other row.
-void MeasureCells(const cv::Mat& bgr, const Grid& grid, float* sums, uint8_t* peaks) {
-  const int bytes_per_cell = grid.cell_px * 3;
-#if defined(__SSE2__)
-  if (bytes_per_cell % 16 == 0) {
-    MeasureCellsSse2(bgr, grid, sums, peaks);
-    return;
-  }
-#endif
-  for (int row = 0; row < grid.rows; ++row) {
-    for (int column = 0; column < grid.columns; ++column) {
-      uint32_t sum = 0;
-      uint8_t peak = 0;
-      for (int y = 0; y < grid.cell_px; y += kAutoRowStep) {
-        const uint8_t* pixel = bgr.ptr<uint8_t>(grid.y0_px[static_cast<size_t>(row)] + y) +
-                               grid.x0_px[static_cast<size_t>(column)] * 3;
-        for (int u = 0; u < bytes_per_cell; ++u) {
-          sum += pixel[u];
-          peak = std::max(peak, pixel[u]);
-        }
-      }
-      const size_t cell = static_cast<size_t>(row * grid.columns + column);
-      sums[cell] = static_cast<float>(sum);
-      peaks[cell] = peak;
-    }
-  }
 }
 
 enum class Level : uint8_t { kUnknown, kLow, kHigh };
@@ -423,871 +332,933 @@ struct LedDetector::Impl {
   double FlatFrac() const { return located ? kFlatFracLocated : kFlatFracRoi; }
   size_t Cells() const { return static_cast<size_t>(grid.cells()); }
 
-  cv::Rect RegionRect(int region) const {
-    if (!located) return options.roi_px;
-    const auto column = static_cast<size_t>(region % block_columns);
-    const auto row = static_cast<size_t>(region / block_columns);
-    const int x0 = grid.x0_px[column], y0 = grid.y0_px[row];
-    return cv::Rect(x0, y0, grid.x0_px[column + 1] + grid.cell_px - x0,
-                    grid.y0_px[row + 1] + grid.cell_px - y0);
-  }
+  cv::Rect RegionRect(int region) const;
 
-  Status Setup(const Frame& frame) {
-    width_px = frame.bgr.cols;
-    height_px = frame.bgr.rows;
-    after_frames = options.min_on_frames;
-    ring = kBeforeFrames + 1 + after_frames;
-    if (width_px < 2 * options.cell_px || height_px < 2 * options.cell_px) {
-      return InvalidArgumentError("frame " + std::to_string(width_px) + "x" +
-                                  std::to_string(height_px) + " is smaller than 2 x 2 cells of " +
-                                  std::to_string(options.cell_px) + " px (cell_px)");
-    }
-    if (located) {
-      grid = Grid::Make(width_px, height_px, options.cell_px, 1);
-      block_columns = grid.columns - 1;
-      regions = block_columns * (grid.rows - 1);
-      pixels_per_region = 4.0 * grid.sampled_px_per_cell;
-    } else {
-      const cv::Rect& roi = options.roi_px;
-      if (roi.x < 0 || roi.y < 0 || roi.x + roi.width > width_px ||
-          roi.y + roi.height > height_px) {
-        return InvalidArgumentError("LED ROI " + RectText(roi) + " is outside the " +
-                                    std::to_string(width_px) + "x" + std::to_string(height_px) +
-                                    " frame");
-      }
-      grid = Grid::Make(width_px, height_px, options.cell_px, kReferenceStride);
-      regions = 1;
-      const auto pixels = static_cast<size_t>(roi.area());
-      top_pixels = std::min(pixels, std::max(kTopPixelsMin, pixels / kTopPixelsShare));
-      pixels_per_region = static_cast<double>(top_pixels);
-      roi_pictures.assign(static_cast<size_t>(ring) * pixels * 3, 0);
-      pixel_reference.assign(pixels, 0.0f);
-      changes.assign(pixels, 0.0f);
-      corrected.assign(pixels * static_cast<size_t>(ring), 0.0f);
-      pixel_steps.assign(pixels, 0.0);
-      channel_steps.assign(pixels, 0.0);
-      lit_peaks.assign(pixels, 0.0);
-      pixel_wobble.assign(pixels, 0.0);
-      dating_series.assign(static_cast<size_t>(ring), 0.0);
-      row_gains.assign(static_cast<size_t>(ring) * static_cast<size_t>(roi.height), 1.0f);
-      for (int x = 0; x < width_px; x += kStripStepPx) {
-        if (x < roi.x - kStripStepPx || x >= roi.x + roi.width + kStripStepPx) {
-          strip_columns.push_back(static_cast<size_t>(x));
-        }
-      }
-      strip_reference.assign(strip_columns.size() * static_cast<size_t>(roi.height), 0.0f);
-      band_gains.assign(static_cast<size_t>(GainBands()), 1.0f);
-      strip_ring.assign(static_cast<size_t>(ring) * strip_reference.size(), 0.0f);
-      row_ratios.reserve(std::max(strip_columns.size() * static_cast<size_t>(kGainBandRows), static_cast<size_t>(roi.width)));
-    }
-    const auto slots = static_cast<size_t>(ring);
-    ring_index.assign(slots, 0);
-    ring_t_ns.assign(slots, 0);
-    ring_gain.assign(slots, 1.0);
-    cell_sums.assign(slots * Cells(), 0.0f);
-    region_sums.assign(slots * static_cast<size_t>(regions), 0.0);
-    cell_peaks.assign(slots * Cells(), 0);
-    cell_reference.assign(Cells(), 0.0f);
-    region_noise.assign(static_cast<size_t>(regions), 0.0f);
-    level.assign(static_cast<size_t>(regions), Level::kUnknown);
-    level_step.assign(static_cast<size_t>(regions), 0.0f);
-    events_per_region.assign(static_cast<size_t>(regions), 0);
-    raw_sums.assign(Cells(), 0.0f);
-    window_values.resize(static_cast<size_t>(ring));
-    window_copy.resize(static_cast<size_t>(ring));
-    window_peaks.resize(static_cast<size_t>(ring));
-    window_sums.resize(static_cast<size_t>(ring));
-    return Status::Ok();
-  }
+  Status Setup(const Frame& frame);
 
   // the frame's brightness against the cells' references: flicker of the lighting scales
   // the whole scene (not the LED's own light), so it is taken out additively
-  double Gain() {
-    if (frames == 0) return 1.0;
-    const double min_reference = kGainMinLevels * 3.0 * grid.sampled_px_per_cell;
-    const int stride = located ? kGainStride : 1;
-    ratios.clear();
-    for (int row = 0; row < grid.rows; row += stride) {
-      for (int column = 0; column < grid.columns; column += stride) {
-        const auto cell = static_cast<size_t>(row * grid.columns + column);
-        if (static_cast<double>(cell_reference[cell]) > min_reference) {
-          ratios.push_back(raw_sums[cell] / cell_reference[cell]);
-        }
-      }
-    }
-    if (ratios.empty()) return 1.0;
-    return static_cast<double>(MedianOf(ratios.data(), static_cast<int>(ratios.size())));
-  }
+  double Gain();
 
-  void Measure(const Frame& frame, size_t slot) {
-    uint8_t* peaks = &cell_peaks[slot * Cells()];
-    MeasureCells(frame.bgr, grid, raw_sums.data(), peaks);
-    const double gain = Gain();
-    ring_gain[slot] = gain;
-    const auto excess = static_cast<float>(gain - 1.0);
-    // the references average the first frames, then follow slowly (a lit LED joins its
-    // region's reference only after a while, so the region is corrected as the scene)
-    const double follow_rate = 1.0 / std::min(kReferenceFrames, static_cast<double>(frames + 1));
-    const auto follow = static_cast<float>(follow_rate);
-    float* cells = &cell_sums[slot * Cells()];
-    for (size_t cell = 0; cell < Cells(); ++cell) {
-      if (frames == 0) cell_reference[cell] = raw_sums[cell];
-      cells[cell] = raw_sums[cell] - excess * cell_reference[cell];
-      cell_reference[cell] += follow * (raw_sums[cell] - cell_reference[cell]);
-    }
-    double* sums = &region_sums[slot * static_cast<size_t>(regions)];
-    if (!located) {
-      sums[0] = MeasureRoi(frame.bgr, slot, gain);
-      return;
-    }
-    // blocks of 2 x 2 cells
-    const auto columns = static_cast<size_t>(grid.columns);
-    const auto blocks = static_cast<size_t>(block_columns);
-    for (size_t row = 0; row + 1 < static_cast<size_t>(grid.rows); ++row) {
-      const float* top = cells + row * columns;
-      const float* bottom = top + columns;
-      double* out = sums + row * blocks;
-      for (size_t c = 0; c < blocks; ++c) {
-        out[c] = static_cast<double>(top[c] + top[c + 1] + bottom[c] + bottom[c + 1]);
-      }
-    }
-  }
+  void Measure(const Frame& frame, size_t slot);
 
-  uint8_t* RoiPicture(size_t slot) {
-    return &roi_pictures[slot * static_cast<size_t>(options.roi_px.area()) * 3];
-  }
+  uint8_t* RoiPicture(size_t slot);
 
   // with an ROI, the detection signal: the sum of the top_pixels largest increases of
   // B + G + R over each pixel's reference (the scene's part scaled by the frame's gain),
   // plus the top_pixels largest decreases (negative): a light switching on raises it,
   // switching off lowers it, and however small the light, its pixels are among those
-  void FollowReference(const uint8_t* picture, const float* strip) {
-    ++reference_frames;
-    const auto rate = static_cast<float>(
-        1.0 / std::min(kReferenceFrames, static_cast<double>(reference_frames)));
-    for (size_t i = 0; i < pixel_reference.size(); ++i, picture += 3) {
-      const auto brightness = static_cast<float>(picture[0] + picture[1] + picture[2]);
-      pixel_reference[i] += rate * (brightness - pixel_reference[i]);
-    }
-    for (size_t i = 0; i < strip_reference.size(); ++i) {
-      strip_reference[i] += rate * (strip[i] - strip_reference[i]);
-    }
-  }
+  void FollowReference(const uint8_t* picture, const float* strip);
 
   float* StripSamples(size_t slot) { return &strip_ring[slot * strip_reference.size()]; }
 
   // the frame's rows beside the ROI (B + G + R every kStripStepPx px)
-  void SampleStrips(const cv::Mat& bgr, float* strip) const {
-    const size_t columns = strip_columns.size();
-    for (int y = 0; y < options.roi_px.height; ++y) {
-      const uint8_t* line = bgr.ptr<uint8_t>(options.roi_px.y + y);
-      float* out = strip + static_cast<size_t>(y) * columns;
-      for (size_t s = 0; s < columns; ++s) {
-        const uint8_t* pixel = line + 3 * strip_columns[s];
-        out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]);
-      }
-    }
-  }
+  void SampleStrips(const cv::Mat& bgr, float* strip) const;
 
-  float* RowGains(size_t slot) {
-    return &row_gains[slot * static_cast<size_t>(options.roi_px.height)];
-  }
+  float* RowGains(size_t slot);
 
   // each row's gain: mains flicker seen by a rolling shutter bands the rows. The median
   // ratio of the frame's row beside the ROI (every kStripStepPx px) to its reference, so
   // the LED, however large in its ROI, never counts; the frame's gain where the row beside
   // the ROI is too short or too dark. An ROI as wide as the frame uses its own row instead,
   // leaving out pixels brighter than kRowRatioMax times the frame's gain (a lit light).
-  void MeasureRowGains(const uint8_t* picture, const float* strip, double gain, float* gains) {
-    const auto min_reference = static_cast<float>(3.0 * kGainMinLevels);
-    const size_t columns = strip_columns.size();
-    const auto width = static_cast<size_t>(options.roi_px.width);
-    const auto most = static_cast<float>(kRowRatioMax * gain);
-    for (int band = 0; band < GainBands(); ++band) {
-      const int y = BandRow(band);
-      const int band_end = std::min(options.roi_px.height, (band + 1) * kGainBandRows);
-      const auto band_rows = static_cast<size_t>(band_end - band * kGainBandRows);
-      const size_t samples = columns * band_rows;
-      row_ratios.clear();
-      if (columns >= kStripMinSamples) {
-        const size_t first = static_cast<size_t>(band * kGainBandRows) * columns;
-        const float* reference = &strip_reference[first];
-        const float* brightness = strip + first;
-        for (size_t s = 0; s < samples; ++s) {
-          if (reference[s] >= min_reference) row_ratios.push_back(brightness[s] / reference[s]);
-        }
-      } else {
-        const size_t first = static_cast<size_t>(y) * width;
-        for (size_t i = first; i < first + width; ++i) {
-          const uint8_t* pixel = picture + 3 * i;
-          if (pixel_reference[i] < min_reference) continue;
-          const float ratio = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / pixel_reference[i];
-          if (ratio < most) row_ratios.push_back(ratio);
-        }
-      }
-      const size_t needed = columns >= kStripMinSamples ? samples : width;
-      const float band_gain =
-          2 * row_ratios.size() > needed
-              ? MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size()))
-              : static_cast<float>(gain);
-      band_gains[static_cast<size_t>(band)] = band_gain;
-    }
-    // every row: linear between the measured rows around it
-    for (int y = 0; y < options.roi_px.height; ++y) {
-      const int band = std::clamp((y - kGainBandRows / 2) / kGainBandRows, 0, GainBands() - 1);
-      const int next = std::min(band + 1, GainBands() - 1);
-      const int from = BandRow(band), to = BandRow(next);
-      const float weight =
-          to > from ? std::clamp(static_cast<float>(y - from) / static_cast<float>(to - from), 0.0f, 1.0f)
-                    : 0.0f;
-      gains[y] = band_gains[static_cast<size_t>(band)] +
-                 weight * (band_gains[static_cast<size_t>(next)] - band_gains[static_cast<size_t>(band)]);
-    }
-  }
+  void MeasureRowGains(const uint8_t* picture, const float* strip, double gain, float* gains);
 
   // the ROI's rows in bands of kGainBandRows (banding changes slowly from row to row), each
   // measured on all its rows and taken for its middle row; rows between are interpolated
   int GainBands() const { return (options.roi_px.height + kGainBandRows - 1) / kGainBandRows; }
-  int BandRow(int band) const {
-    return std::min(band * kGainBandRows + kGainBandRows / 2, options.roi_px.height - 1);
-  }
+  int BandRow(int band) const;
 
-  double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain) {
-    const cv::Rect& roi = options.roi_px;
-    uint8_t* picture = RoiPicture(slot);
-    float* strip = StripSamples(slot);
-    // the frame leaving the ring joins the references (the first frame starts them)
-    if (frames >= ring) FollowReference(picture, strip);
-    const auto row_bytes = static_cast<size_t>(roi.width) * 3;
-    for (int y = 0; y < roi.height; ++y) {
-      std::memcpy(picture + static_cast<size_t>(y) * row_bytes, bgr.ptr<uint8_t>(roi.y + y) + roi.x * 3,
-                  row_bytes);
-    }
-    SampleStrips(bgr, strip);
-    if (frames == 0) {
-      reference_frames = 0;
-      std::fill(pixel_reference.begin(), pixel_reference.end(), 0.0f);
-      std::fill(strip_reference.begin(), strip_reference.end(), 0.0f);
-      FollowReference(picture, strip);
-    }
-    float* gains = RowGains(slot);
-    MeasureRowGains(picture, strip, gain, gains);
-    const auto width = static_cast<size_t>(roi.width);
-    const uint8_t* pixel = picture;
-    for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
-      changes[i] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
-                   gains[i / width] * pixel_reference[i];
-    }
-    const auto top = static_cast<std::ptrdiff_t>(top_pixels);
-    std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end(), std::greater<>());
-    double signal = std::accumulate(changes.begin(), changes.begin() + top, 0.0);
-    std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end());
-    signal += std::accumulate(changes.begin(), changes.begin() + top, 0.0);
-    return signal;
-  }
+  double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain);
+
+  // Whether the pixels that stepped strongly (kRoiStrongFrac of the largest step or more)
+  // are a small light, within a kSmallLightPx square, that the strong steps the other way
+  // do not match: a codec that renews a tiny LED's block moves many pixels a little either
+  // way (too many for the sum of every clear step), where an edge that moved steps its two
+  // sides strongly along its length. Reads pixel_steps.
+  bool SmallLightInRenewedBlock(double largest, size_t width) const;
 
   // with an ROI: which pixels stepped at k, from the pictures around it. The dating series
   // sums the pixels that brightened (rise) or darkened (fall) clearly, leaving out those
   // that clip when lit unless they carry most of the step (then the event is marked
   // clipped). False when the step does not look like a light: pixels stepping the other
   // way by a good part of it (an edge moved by camera shake or a passing part).
-  // Whether the pixels that stepped strongly (kRoiStrongFrac of the largest step or more)
-  // are a small light, within a kSmallLightPx square, that the strong steps the other way
-  // do not match: a codec that renews a tiny LED's block moves many pixels a little either
-  // way (too many for the sum of every clear step), where an edge that moved steps its two
-  // sides strongly along its length. Reads pixel_steps.
-  bool SmallLightInRenewedBlock(double largest, size_t width) const {
-    const double strong = kRoiStrongFrac * largest;
-    double stepped_strong = 0.0, opposite_strong = 0.0;
-    size_t x0 = width, x1 = 0, y0 = pixel_steps.size(), y1 = 0;
-    for (size_t i = 0; i < pixel_steps.size(); ++i) {
-      if (pixel_steps[i] > strong) {
-        stepped_strong += pixel_steps[i];
-        x0 = std::min(x0, i % width);
-        x1 = std::max(x1, i % width);
-        y0 = std::min(y0, i / width);
-        y1 = std::max(y1, i / width);
-      } else if (pixel_steps[i] < -strong) {
-        opposite_strong -= pixel_steps[i];
-      }
-    }
-    const bool small = x1 >= x0 && x1 - x0 < kSmallLightPx && y1 - y0 < kSmallLightPx;
-    return small && opposite_strong <= kRoiOppositeFrac * stepped_strong;
-  }
+  bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event);
 
-  bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
-    const size_t pixels = pixel_reference.size();
-    const auto frames_in_ring = static_cast<size_t>(ring);
-    const auto before = static_cast<size_t>(kBeforeFrames);
-    const auto width = static_cast<size_t>(options.roi_px.width);
-    std::vector<float> peaks(frames_in_ring);
-    double off_sum = 0.0, on_sum = 0.0;
-    for (size_t i = 0; i < pixels; ++i) {
-      float* values = &corrected[i * frames_in_ring];
-      for (size_t j = 0; j < frames_in_ring; ++j) {
-        const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
-        const uint8_t* pixel = RoiPicture(slot) + 3 * i;
-        values[j] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
-                    (RowGains(slot)[i / width] - 1.0f) * pixel_reference[i];
-        peaks[j] = static_cast<float>(std::max({pixel[0], pixel[1], pixel[2]}));
-      }
-      std::copy(values, values + frames_in_ring, window_sums.begin());
-      const double level_before = MedianOf(window_sums.data(), kBeforeFrames);
-      const double level_after =
-          MedianOf(window_sums.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
-      const double peak_before = MedianOf(peaks.data(), kBeforeFrames);
-      const double peak_after =
-          MedianOf(peaks.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
-      pixel_steps[i] = rise ? level_after - level_before : level_before - level_after;
-      channel_steps[i] = rise ? peak_after - peak_before : peak_before - peak_after;
-      lit_peaks[i] = rise ? peak_after : peak_before;
-      pixel_wobble[i] = std::abs(static_cast<double>(values[before - 1] - values[before - 2]));
-      off_sum += rise ? level_before : level_after;
-      on_sum += rise ? level_after : level_before;
-    }
-    // a pixel's noise (the median frame-to-frame change is 0.95 sigma for Gaussian noise)
-    const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
-    const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
-    const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
-    double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
-    for (size_t i = 0; i < pixels; ++i) {
-      if (pixel_steps[i] > clear) {
-        stepped += pixel_steps[i];
-        if (lit_peaks[i] < kClipLevels) unclipped += pixel_steps[i];
-      } else if (pixel_steps[i] < -clear) {
-        opposite -= pixel_steps[i];
-      }
-    }
-    if (stepped <= 0.0) return false;
-    if (opposite > kRoiOppositeFrac * stepped && !SmallLightInRenewedBlock(largest, width)) {
-      return false;
-    }
-    event.clipped = unclipped < kUnclippedShare * stepped;
-    // the dating dating_series and the LED's contrast over the chosen pixels
-    std::fill(dating_series.begin(), dating_series.end(), 0.0);
-    std::vector<double> contrasts;
-    for (size_t i = 0; i < pixels; ++i) {
-      if (!(pixel_steps[i] > clear)) continue;
-      contrasts.push_back(channel_steps[i]);
-      if (!event.clipped && lit_peaks[i] >= kClipLevels) continue;
-      const float* values = &corrected[i * frames_in_ring];
-      for (size_t j = 0; j < frames_in_ring; ++j) dating_series[j] += static_cast<double>(values[j]);
-    }
-    std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
-    event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
-    // the levels: the medians of the frames before and after (the pixels of a small light
-    // may still be catching up after it: the creep widens the partly lit frame's band)
-    const WindowShape shape = ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
-                                      options.threshold_frac, window_copy);
-    if (!(shape.step > 0)) return false;
-    const double widest = std::max(shape.before_spread, shape.after_against);
-    if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {
-      return false;
-    }
-    event.off = rise ? shape.before_level : shape.after_level;
-    event.on = rise ? shape.after_level : shape.before_level;
-    if (!(event.on > event.off)) return false;
-    event.noise = 0.5 * widest;
-    event.creep = shape.after_creep / (event.on - event.off);
-    event.value = dating_series;
-    event.off_levels = off_sum / (3.0 * static_cast<double>(pixels));
-    event.on_levels = on_sum / (3.0 * static_cast<double>(pixels));
-    return true;
-  }
-
-  int64_t PeriodNs() const {
-    if (interval_count == 0) return 0;
-    std::array<int64_t, kIntervalWindow> copy = intervals_ns;
-    return MedianOf(copy.data(), static_cast<int>(std::min(interval_count, kIntervalWindow)));
-  }
+  int64_t PeriodNs() const;
 
   // what a step's jump must exceed to stand out from the frame at k (with an ROI: the
   // reference cells' sharp jumps, scaled to the ROI's size)
-  double OutlierJump(int64_t k) {
-    jumps.clear();
-    const int64_t last = std::min<int64_t>(k + 2, k + after_frames);
-    const auto sharp = [](double before, double previous, double next, double after) {
-      const double wobble = std::max(std::abs(previous - before), std::abs(after - next));
-      return std::max(0.0, std::abs(next - previous) - 2.0 * wobble);
-    };
-    if (located) {
-      const auto at = [&](int64_t frame) {
-        return &region_sums[Slot(frame) * static_cast<size_t>(regions)];
-      };
-      const double *before = at(k - 2), *previous = at(k - 1), *next = at(k + 1), *after = at(last);
-      const size_t count = static_cast<size_t>(regions), stride = SampleStride(count);
-      for (size_t r = 0; r < count; r += stride) {
-        jumps.push_back(sharp(before[r], previous[r], next[r], after[r]));
-      }
-    } else {
-      const auto at = [&](int64_t frame) { return &cell_sums[Slot(frame) * Cells()]; };
-      const float *before = at(k - 2), *previous = at(k - 1), *next = at(k + 1), *after = at(last);
-      const double scale = pixels_per_region / grid.sampled_px_per_cell;
-      for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
-        jumps.push_back(scale * sharp(before[c], previous[c], next[c], after[c]));
-      }
-    }
-    return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
-  }
+  double OutlierJump(int64_t k);
 
   // what a step's contrast must reach to stand out from the frame at k: the brightest
   // channel of most cells stays put, except where many step together
-  double OutlierContrast(int64_t k) {
-    jumps.clear();
-    const uint8_t* previous = &cell_peaks[Slot(k - 1) * Cells()];
-    const uint8_t* next = &cell_peaks[Slot(k + 1) * Cells()];
-    const double previous_gain = ring_gain[Slot(k - 1)], next_gain = ring_gain[Slot(k + 1)];
-    for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
-      jumps.push_back(std::abs(next[c] / next_gain - previous[c] / previous_gain));
-    }
-    return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
-  }
+  double OutlierContrast(int64_t k);
 
   // the step test for frame k = newest - after_frames, every region
-  void Evaluate() {
-    const int64_t k = frames - 1 - after_frames;
-    const double min_step = kMinStepLevels * 3.0 * pixels_per_region;
-    const double* next = &region_sums[Slot(k + 1) * static_cast<size_t>(regions)];
-    const double* previous = &region_sums[Slot(k - 1) * static_cast<size_t>(regions)];
-    const double* earlier = &region_sums[Slot(k - 2) * static_cast<size_t>(regions)];
-    const auto follow = static_cast<float>(1.0 / kNoiseFrames);
-    double outlier_jump = -1.0;  // computed when first needed
-    double outlier_contrast = -1.0;
-    for (int region = 0; region < regions; ++region) {
-      const auto r = static_cast<size_t>(region);
-      const double jump = next[r] - previous[r];
-      const double needed = std::max(min_step, kNoiseFactor * static_cast<double>(region_noise[r]));
-      region_noise[r] +=
-          follow * (static_cast<float>(std::abs(previous[r] - earlier[r])) - region_noise[r]);
-      // a region at a level steps only the other way, unless by far more than the step
-      // that set the level (a faint step before the LED's must not hide it)
-      const bool stronger = std::abs(jump) > kStrongerFactor * static_cast<double>(level_step[r]);
-      const bool rise = jump > needed && (level[r] != Level::kHigh || stronger);
-      const bool fall = jump < -needed && (level[r] != Level::kLow || stronger);
-      if (rise || fall) {
-        TestStep(region, k, rise, min_step, std::abs(jump), outlier_jump, outlier_contrast);
-      }
-    }
-  }
+  void Evaluate();
 
   // the step of one series of the ring (medians of the windows before and after k),
   // signed so that the step's direction is positive
   template <typename T>
   double WindowStep(const std::vector<T>& series, size_t stride, size_t offset, int64_t k,
-                    bool rise, std::vector<T>& window) const {
-    for (int i = 0; i < ring; ++i) {
-      window[static_cast<size_t>(i)] = series[Slot(k - kBeforeFrames + i) * stride + offset];
-    }
-    const double before = MedianOf(window.data(), kBeforeFrames);
-    const double after = MedianOf(window.data() + kBeforeFrames + 1, after_frames);
-    return rise ? after - before : before - after;
-  }
+                    bool rise, std::vector<T>& window) const;
 
   // located: the LED's own contrast, grey levels: the step of the brightest channel of the
   // block's best cell, or of its mean where that is larger (a brighter object beside the
   // LED hides its brightest pixel)
-  double Contrast(int region, int64_t k, bool rise) {
-    const int column = region % block_columns, row = region / block_columns;
-    double contrast = 0.0;
-    for (int dy = 0; dy < 2; ++dy) {
-      for (int dx = 0; dx < 2; ++dx) {
-        const auto cell = static_cast<size_t>((row + dy) * grid.columns + column + dx);
-        const double peak_step = WindowStep(cell_peaks, Cells(), cell, k, rise, window_peaks);
-        const double mean_step = WindowStep(cell_sums, Cells(), cell, k, rise, window_sums) /
-                                 (3.0 * grid.sampled_px_per_cell);
-        contrast = std::max(contrast, std::max(peak_step, mean_step));
-      }
-    }
-    return contrast;
-  }
+  double Contrast(int region, int64_t k, bool rise);
 
   void TestStep(int region, int64_t k, bool rise, double min_step, double jump,
-                double& outlier_jump, double& outlier_contrast) {
-    const auto at = [&](int64_t frame) {
-      return Slot(frame) * static_cast<size_t>(regions) + static_cast<size_t>(region);
-    };
-    const auto count = static_cast<size_t>(ring);
-    for (size_t i = 0; i < count; ++i) {
-      window_values[i] = region_sums[at(k - kBeforeFrames + static_cast<int64_t>(i))];
-    }
-    const auto before = window_values.cbegin();
-    const auto before_end = before + kBeforeFrames;
-    const auto after = before_end + 1;
-    const auto after_end = window_values.cend();
-    const auto [before_low, before_high] = std::minmax_element(before, before_end);
-    const auto [after_low, after_high] = std::minmax_element(after, after_end);
-    const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, after_frames, rise,
-                                      options.threshold_frac, window_copy);
-    const double before_level = shape.before_level, after_level = shape.after_level;
-    const double step = shape.step;
-    const double before_spread = shape.before_spread;
-    if (step < min_step) return;
-    const double flat = FlatFrac();
-    if (before_spread > flat * step || shape.after_against > flat * step ||
-        shape.after_creep > kCreepFrac * step) {
-      return;
-    }
-    // a partly lit frame just after k is the next frame's transition: wait for it
-    if (std::abs(*after - after_level) > 0.5 * flat * step) return;
-    const double off = rise ? before_level : after_level;
-    const double threshold = off + options.threshold_frac * step;
-    if (rise ? !(*before_high<threshold&& * after_low> threshold)
-             : !(*before_low > threshold && *after_high < threshold)) {
-      return;
-    }
-    if (outlier_jump < 0) outlier_jump = OutlierJump(k);
-    if (jump < outlier_jump) return;
-
-    StepEvent event;
-    if (!located && !MeasureRoiStep(k, rise, event)) return;
-    const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
-    if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
-    if (contrast < outlier_contrast) return;
-    if (contrast < options.min_contrast_levels) {
-      if (rise && contrast > rejected_contrast) {
-        rejected_contrast = contrast;
-        rejected_region = region;
-      }
-      return;
-    }
-    if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
-
-    event.region = region;
-    event.rise = rise;
-    event.signal_step = step;
-    event.signal_off = off;
-    event.signal_on = off + step;
-    event.contrast_levels = contrast;
-    event.period_ns = PeriodNs();
-    for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
-      event.index.push_back(ring_index[Slot(frame)]);
-      event.t_ns.push_back(ring_t_ns[Slot(frame)]);
-    }
-    if (located) {
-      // the block's own sums date the step
-      event.off = off;
-      event.on = off + step;
-      event.noise = 0.5 * std::max({before_spread, shape.after_against, shape.after_creep});
-      event.off_levels = event.off / (3.0 * pixels_per_region);
-      event.on_levels = event.on / (3.0 * pixels_per_region);
-      for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
-        event.value.push_back(region_sums[at(frame)]);
-      }
-      RecordCellSteps(event, k);
-      if (!LooksLikeALight(event)) return;
-    }
-    event.frames_to_confirm = kConfirmFrames;
-    event.level_before = level[static_cast<size_t>(region)];
-    event.level_step_before = level_step[static_cast<size_t>(region)];
-    level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
-    level_step[static_cast<size_t>(region)] = static_cast<float>(step);
-    ++events_per_region[static_cast<size_t>(region)];
-    pending.push_back(std::move(event));
-  }
+                double& outlier_jump, double& outlier_contrast);
 
   // the step of each of the 4 x 4 cells around the block (medians of the same windows)
-  void RecordCellSteps(StepEvent& event, int64_t k) {
-    const int block_column = event.region % block_columns, block_row = event.region / block_columns;
-    for (int dy = 0; dy < 4; ++dy) {
-      for (int dx = 0; dx < 4; ++dx) {
-        const int column = block_column - 1 + dx, row = block_row - 1 + dy;
-        float cell_step = 0.0f;
-        if (column >= 0 && column < grid.columns && row >= 0 && row < grid.rows) {
-          const auto cell = static_cast<size_t>(row * grid.columns + column);
-          cell_step =
-              static_cast<float>(WindowStep(cell_sums, Cells(), cell, k, event.rise, window_sums));
-        }
-        event.cell_steps[static_cast<size_t>(dy * 4 + dx)] = cell_step;
-      }
-    }
-  }
+  void RecordCellSteps(StepEvent& event, int64_t k);
 
   // the steps being confirmed against the newest frame: confirmed ones join `events`,
   // rejected ones give their region back its level
-  void Confirm(size_t slot) {
-    size_t kept = 0;
-    for (StepEvent& event : pending) {
-      const double value =
-          region_sums[slot * static_cast<size_t>(regions) + static_cast<size_t>(event.region)];
-      const double tolerance = FlatFrac() * event.signal_step;
-      const double held = event.rise ? event.signal_on : event.signal_off;
-      const double left = event.rise ? event.signal_off : event.signal_on;
-      const double beyond = (event.rise ? 1.0 : -1.0) * (value - held);
-      const bool holds = std::abs(value - held) <= tolerance ||
-                         (beyond > 0 && beyond <= kCreepFrac * event.signal_step);
-      bool done = false;
-      if (std::abs(value - left) <= tolerance) {
-        done = true;  // back already: a short pulse
-      } else if (!holds && ++event.between > 1) {
-        level[static_cast<size_t>(event.region)] = event.level_before;
-        level_step[static_cast<size_t>(event.region)] = event.level_step_before;
-        --events_per_region[static_cast<size_t>(event.region)];
-        continue;
-      }
-      if (done || --event.frames_to_confirm <= 0) {
-        events.push_back(std::move(event));
-        continue;
-      }
-      if (&pending[kept] != &event) pending[kept] = std::move(event);
-      ++kept;
-    }
-    pending.resize(kept);
-  }
+  void Confirm(size_t slot);
 
   // a light switching is local and one-signed: the cells around the block do not step the
   // other way (an edge moving by, with camera shake or a passing foot, darkens one side as
   // it brightens the other), and its step is about as wide as it is tall (an edge or a
   // band shifted across the region steps a row or a column of cells)
-  static bool LooksLikeALight(const StepEvent& event) {
-    const auto cell = [&](int row, int column) {
-      return static_cast<double>(event.cell_steps[static_cast<size_t>(row * 4 + column)]);
-    };
-    const double centre = cell(1, 1) + cell(1, 2) + cell(2, 1) + cell(2, 2);
-    if (centre <= 0) return false;
-    double opposite = 0.0, largest = 0.0;
-    for (const float step : event.cell_steps) {
-      opposite += std::max(0.0, -static_cast<double>(step));
-      largest = std::max(largest, static_cast<double>(step));
-    }
-    if (opposite > kOppositeFrac * centre) return false;
-    // the widest row and the tallest column of cells that step by a good part of the most
-    int wide = 0, tall = 0;
-    for (int i = 0; i < 4; ++i) {
-      int in_row = 0, in_column = 0;
-      for (int j = 0; j < 4; ++j) {
-        in_row += cell(i, j) >= kExtentFrac * largest;
-        in_column += cell(j, i) >= kExtentFrac * largest;
-      }
-      wide = std::max(wide, in_row);
-      tall = std::max(tall, in_column);
-    }
-    return std::abs(wide - tall) < 2;
-  }
+  static bool LooksLikeALight(const StepEvent& event);
 
-  Status Process(const Frame& frame) {
-    LIFTOFF_RETURN_IF_ERROR(options_status);
-    if (frame.bgr.empty() || frame.bgr.type() != CV_8UC3) {
-      return InvalidArgumentError("frame " + std::to_string(frame.index) +
-                                  ": expected an 8-bit BGR picture");
-    }
-    if (frames == 0) {
-      LIFTOFF_RETURN_IF_ERROR(Setup(frame));
-    } else {
-      if (frame.bgr.cols != width_px || frame.bgr.rows != height_px) {
-        return InvalidArgumentError("frame " + std::to_string(frame.index) + " is " +
-                                    std::to_string(frame.bgr.cols) + "x" +
-                                    std::to_string(frame.bgr.rows) + ", the first was " +
-                                    std::to_string(width_px) + "x" + std::to_string(height_px));
-      }
-      if (frame.t_ns <= last_t_ns) {
-        return InvalidArgumentError("frame " + std::to_string(frame.index) + " at " +
-                                    std::to_string(frame.t_ns) +
-                                    " ns is not after the previous frame");
-      }
-      intervals_ns[interval_count % kIntervalWindow] = frame.t_ns - last_t_ns;
-      ++interval_count;
-    }
-    last_t_ns = frame.t_ns;
-    const size_t slot = Slot(frames);
-    ring_index[slot] = frame.index;
-    ring_t_ns[slot] = frame.t_ns;
-    Measure(frame, slot);
-    Confirm(slot);
-    ++frames;
-    if (frames >= ring) Evaluate();
-    return Status::Ok();
-  }
+  Status Process(const Frame& frame);
 
   // the instant of one step, from its frames
   // A frame partly lit by a switch-on is followed by a fully lit one (an exposure of at most
   // the frame interval cannot be partly lit twice), so the frame before a partly lit one is
   // not taken for the partly lit frame, however much light a codec lent it.
-  LedPulse DatePulse(const StepEvent& event) const {
-    const auto exposure_ns = static_cast<double>(NsFromSeconds(options.exposure_s));
-    const ExposureRange exposure =
-        exposure_ns > 0 ? ExposureRange{exposure_ns, exposure_ns}
-                        : ExposureRange{0.0, static_cast<double>(event.period_ns)};
-    const double scale = event.on - event.off;
-    const double noise_fraction = event.noise / scale;
-    const double band = std::max(kFractionSigmas * noise_fraction, kFractionMargin);
-    const double lit_above = std::max(kFractionSigmas * noise_fraction, kLitFraction);
-    const auto fraction = [&](size_t i) { return (event.value[i] - event.off) / scale; };
-    // what the partly lit frame saw: its fraction within the noise band; when the LED's
-    // pixels clip, a partly lit frame looks brighter than it was, so only the upper bound
-    // holds
-    const auto lit_band = [&](double f) {
-      return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - band - event.creep),
-                         std::min(1.0, f + band)};
-    };
-    const LitFraction dark{0.0, lit_above};
-    const size_t count = event.value.size();
-    LedPulse pulse;
-    if (event.rise) {
-      // the first frame above the threshold (the before-window frames are below it), or
-      // the partly lit one just before it
-      size_t lit = kBeforeFrames;
-      for (size_t i = 0; i < count; ++i) {
-        if (fraction(i) > options.threshold_frac) {
-          lit = i;
-          break;
-        }
-      }
-      if (lit >= 2 && fraction(lit - 1) > lit_above && fraction(lit) >= 1.0 - band) --lit;
-      const double f = std::clamp(fraction(lit), 0.0, 1.0);
-      const InstantInterval interval =
-          internal::SwitchOnInterval(static_cast<double>(event.t_ns[lit - 1]), dark,
-                                     static_cast<double>(event.t_ns[lit]), lit_band(f), exposure);
-      pulse.on_ns = interval.Middle();
-      pulse.on_uncertainty_ns = interval.HalfWidth();
-      pulse.first_lit_frame = event.index[lit];
-      pulse.first_lit_fraction = f;
-    } else {
-      // the last frame above the threshold (the after-window frames are below it), or the
-      // partly lit one just after it
-      size_t lit = kBeforeFrames - 1;
-      for (size_t i = count; i-- > 0;) {
-        if (fraction(i) > options.threshold_frac) {
-          lit = i;
-          break;
-        }
-      }
-      if (lit + 2 < count && fraction(lit + 1) > lit_above && fraction(lit) >= 1.0 - band) ++lit;
-      const double f = std::clamp(fraction(lit), 0.0, 1.0);
-      const InstantInterval interval =
-          internal::SwitchOffInterval(static_cast<double>(event.t_ns[lit]), lit_band(f),
-                                      static_cast<double>(event.t_ns[lit + 1]), dark, exposure);
-      pulse.off_ns = interval.Middle();
-      pulse.off_uncertainty_ns = interval.HalfWidth();
-    }
-    return pulse;
-  }
+  LedPulse DatePulse(const StepEvent& event) const;
 
   // located: a square of the block's size around the centroid of the cells' steps
-  cv::Rect LocatedRect(const StepEvent& event) const {
-    const cv::Rect block = RegionRect(event.region);
-    double weight = 0.0, x = 0.0, y = 0.0;
-    const int block_column = event.region % block_columns, block_row = event.region / block_columns;
-    for (int dy = 0; dy < 4; ++dy) {
-      for (int dx = 0; dx < 4; ++dx) {
-        const int column = block_column - 1 + dx, row = block_row - 1 + dy;
-        const double cell_step = event.cell_steps[static_cast<size_t>(dy * 4 + dx)];
-        if (cell_step <= 0 || column < 0 || row < 0 || column >= grid.columns || row >= grid.rows) {
-          continue;
-        }
-        weight += cell_step;
-        x += cell_step * (grid.x0_px[static_cast<size_t>(column)] + 0.5 * grid.cell_px);
-        y += cell_step * (grid.y0_px[static_cast<size_t>(row)] + 0.5 * grid.cell_px);
-      }
-    }
-    if (weight <= 0) return block;
-    cv::Rect rect(static_cast<int>(std::lround(x / weight - 0.5 * block.width)),
-                  static_cast<int>(std::lround(y / weight - 0.5 * block.height)), block.width,
-                  block.height);
-    rect.x = std::clamp(rect.x, 0, width_px - rect.width);
-    rect.y = std::clamp(rect.y, 0, height_px - rect.height);
-    return rect;
-  }
+  cv::Rect LocatedRect(const StepEvent& event) const;
 
   // the LED's region: among the switch-ons with a brightest-channel contrast near the best
   // one, the largest step
-  static int ChooseRegion(const std::vector<const StepEvent*>& steps) {
-    double best_contrast = 0.0;
-    for (const StepEvent* event : steps) {
-      if (event->rise) best_contrast = std::max(best_contrast, event->contrast_levels);
-    }
-    int best = -1;
-    double best_step = 0.0;
-    for (const StepEvent* event : steps) {
-      if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
-          event->signal_step > best_step) {
-        best_step = event->signal_step;
-        best = event->region;
-      }
-    }
-    return best;
+  static int ChooseRegion(const std::vector<const StepEvent*>& steps);
+
+  Result<LedResult> Finish() const;
+};
+
+cv::Rect LedDetector::Impl::RegionRect(int region) const {
+  if (!located) return options.roi_px;
+  const auto column = static_cast<size_t>(region % block_columns);
+  const auto row = static_cast<size_t>(region / block_columns);
+  const int x0 = grid.x0_px[column], y0 = grid.y0_px[row];
+  return cv::Rect(x0, y0, grid.x0_px[column + 1] + grid.cell_px - x0,
+                  grid.y0_px[row + 1] + grid.cell_px - y0);
+}
+
+Status LedDetector::Impl::Setup(const Frame& frame) {
+  width_px = frame.bgr.cols;
+  height_px = frame.bgr.rows;
+  after_frames = options.min_on_frames;
+  ring = kBeforeFrames + 1 + after_frames;
+  if (width_px < 2 * options.cell_px || height_px < 2 * options.cell_px) {
+    return InvalidArgumentError("frame " + std::to_string(width_px) + "x" +
+                                std::to_string(height_px) + " is smaller than 2 x 2 cells of " +
+                                std::to_string(options.cell_px) + " px (cell_px)");
   }
-
-  Result<LedResult> Finish() const {
-    LIFTOFF_RETURN_IF_ERROR(options_status);
-    if (frames == 0) return InvalidArgumentError("LED detector: no frame was given");
-    const std::string where =
-        located ? "anywhere in the frame" : "in the ROI " + RectText(options.roi_px);
-    // every step, confirmed or still being confirmed at the end, in the order they happened
-    std::vector<const StepEvent*> steps;
-    for (const StepEvent& event : events) steps.push_back(&event);
-    for (const StepEvent& event : pending) steps.push_back(&event);
-    std::sort(steps.begin(), steps.end(), [](const StepEvent* a, const StepEvent* b) {
-      return a->index[kBeforeFrames] < b->index[kBeforeFrames];
-    });
-    const int best = ChooseRegion(steps);
-    if (best < 0) {
-      for (const StepEvent* step : steps) {
-        const StepEvent& event = *step;
-        if (!event.rise) {
-          return NotFoundError("the LED never switches on: the only light step " + where +
-                               " goes off, at " +
-                               FormatFixed(SecondsFromNs(*DatePulse(event).off_ns), 4) +
-                               " s (was the LED already on at the start?)");
-        }
-      }
-      std::string message = "the LED never switches on: no brightness step " + where +
-                            " rises and holds for " + Plural(options.min_on_frames, "frame");
-      if (rejected_region >= 0) {
-        message += " with enough contrast (the best: " + FormatFixed(rejected_contrast, 0) +
-                   " grey levels at " + RectText(RegionRect(rejected_region)) +
-                   ", min_contrast_levels " + FormatFixed(options.min_contrast_levels, 0) + ")";
-      }
-      return NotFoundError(message);
+  if (located) {
+    grid = Grid::Make(width_px, height_px, options.cell_px, 1);
+    block_columns = grid.columns - 1;
+    regions = block_columns * (grid.rows - 1);
+    pixels_per_region = 4.0 * grid.sampled_px_per_cell;
+  } else {
+    const cv::Rect& roi = options.roi_px;
+    if (roi.x < 0 || roi.y < 0 || roi.x + roi.width > width_px || roi.y + roi.height > height_px) {
+      return InvalidArgumentError("LED ROI " + RectText(roi) + " is outside the " +
+                                  std::to_string(width_px) + "x" + std::to_string(height_px) +
+                                  " frame");
     }
-
-    // the LED's own steps: every pulse of one LED has about the same contrast, so the
-    // region's fainter steps are something else (a shadow, a shifted edge)
-    double best_contrast = 0.0;
-    for (const StepEvent* event : steps) {
-      if (event->region == best && event->rise) {
-        best_contrast = std::max(best_contrast, event->contrast_levels);
+    grid = Grid::Make(width_px, height_px, options.cell_px, kReferenceStride);
+    regions = 1;
+    const auto pixels = static_cast<size_t>(roi.area());
+    top_pixels = std::min(pixels, std::max(kTopPixelsMin, pixels / kTopPixelsShare));
+    pixels_per_region = static_cast<double>(top_pixels);
+    roi_pictures.assign(static_cast<size_t>(ring) * pixels * 3, 0);
+    pixel_reference.assign(pixels, 0.0f);
+    changes.assign(pixels, 0.0f);
+    corrected.assign(pixels * static_cast<size_t>(ring), 0.0f);
+    pixel_steps.assign(pixels, 0.0);
+    channel_steps.assign(pixels, 0.0);
+    lit_peaks.assign(pixels, 0.0);
+    pixel_wobble.assign(pixels, 0.0);
+    dating_series.assign(static_cast<size_t>(ring), 0.0);
+    row_gains.assign(static_cast<size_t>(ring) * static_cast<size_t>(roi.height), 1.0f);
+    for (int x = 0; x < width_px; x += kStripStepPx) {
+      if (x < roi.x - kStripStepPx || x >= roi.x + roi.width + kStripStepPx) {
+        strip_columns.push_back(static_cast<size_t>(x));
       }
     }
-    LedResult result;
-    result.roi_located = located;
-    bool first_rise_seen = false;
-    bool already_on = false;
+    strip_reference.assign(strip_columns.size() * static_cast<size_t>(roi.height), 0.0f);
+    band_gains.assign(static_cast<size_t>(GainBands()), 1.0f);
+    strip_ring.assign(static_cast<size_t>(ring) * strip_reference.size(), 0.0f);
+    row_ratios.reserve(std::max(strip_columns.size() * static_cast<size_t>(kGainBandRows),
+                                static_cast<size_t>(roi.width)));
+  }
+  const auto slots = static_cast<size_t>(ring);
+  ring_index.assign(slots, 0);
+  ring_t_ns.assign(slots, 0);
+  ring_gain.assign(slots, 1.0);
+  cell_sums.assign(slots * Cells(), 0.0f);
+  region_sums.assign(slots * static_cast<size_t>(regions), 0.0);
+  cell_peaks.assign(slots * Cells(), 0);
+  cell_reference.assign(Cells(), 0.0f);
+  region_noise.assign(static_cast<size_t>(regions), 0.0f);
+  level.assign(static_cast<size_t>(regions), Level::kUnknown);
+  level_step.assign(static_cast<size_t>(regions), 0.0f);
+  events_per_region.assign(static_cast<size_t>(regions), 0);
+  raw_sums.assign(Cells(), 0.0f);
+  window_values.resize(static_cast<size_t>(ring));
+  window_copy.resize(static_cast<size_t>(ring));
+  window_peaks.resize(static_cast<size_t>(ring));
+  window_sums.resize(static_cast<size_t>(ring));
+  return Status::Ok();
+}
+
+double LedDetector::Impl::Gain() {
+  if (frames == 0) return 1.0;
+  const double min_reference = kGainMinLevels * 3.0 * grid.sampled_px_per_cell;
+  const int stride = located ? kGainStride : 1;
+  ratios.clear();
+  for (int row = 0; row < grid.rows; row += stride) {
+    for (int column = 0; column < grid.columns; column += stride) {
+      const auto cell = static_cast<size_t>(row * grid.columns + column);
+      if (static_cast<double>(cell_reference[cell]) > min_reference) {
+        ratios.push_back(raw_sums[cell] / cell_reference[cell]);
+      }
+    }
+  }
+  if (ratios.empty()) return 1.0;
+  return static_cast<double>(MedianOf(ratios.data(), static_cast<int>(ratios.size())));
+}
+
+void LedDetector::Impl::Measure(const Frame& frame, size_t slot) {
+  uint8_t* peaks = &cell_peaks[slot * Cells()];
+  MeasureCells(frame.bgr, grid, raw_sums.data(), peaks);
+  const double gain = Gain();
+  ring_gain[slot] = gain;
+  const auto excess = static_cast<float>(gain - 1.0);
+  // the references average the first frames, then follow slowly (a lit LED joins its
+  // region's reference only after a while, so the region is corrected as the scene)
+  const double follow_rate = 1.0 / std::min(kReferenceFrames, static_cast<double>(frames + 1));
+  const auto follow = static_cast<float>(follow_rate);
+  float* cells = &cell_sums[slot * Cells()];
+  for (size_t cell = 0; cell < Cells(); ++cell) {
+    if (frames == 0) cell_reference[cell] = raw_sums[cell];
+    cells[cell] = raw_sums[cell] - excess * cell_reference[cell];
+    cell_reference[cell] += follow * (raw_sums[cell] - cell_reference[cell]);
+  }
+  double* sums = &region_sums[slot * static_cast<size_t>(regions)];
+  if (!located) {
+    sums[0] = MeasureRoi(frame.bgr, slot, gain);
+    return;
+  }
+  // blocks of 2 x 2 cells
+  const auto columns = static_cast<size_t>(grid.columns);
+  const auto blocks = static_cast<size_t>(block_columns);
+  for (size_t row = 0; row + 1 < static_cast<size_t>(grid.rows); ++row) {
+    const float* top = cells + row * columns;
+    const float* bottom = top + columns;
+    double* out = sums + row * blocks;
+    for (size_t c = 0; c < blocks; ++c) {
+      out[c] = static_cast<double>(top[c] + top[c + 1] + bottom[c] + bottom[c + 1]);
+    }
+  }
+}
+
+uint8_t* LedDetector::Impl::RoiPicture(size_t slot) {
+  return &roi_pictures[slot * static_cast<size_t>(options.roi_px.area()) * 3];
+}
+
+void LedDetector::Impl::FollowReference(const uint8_t* picture, const float* strip) {
+  ++reference_frames;
+  const auto rate =
+      static_cast<float>(1.0 / std::min(kReferenceFrames, static_cast<double>(reference_frames)));
+  for (size_t i = 0; i < pixel_reference.size(); ++i, picture += 3) {
+    const auto brightness = static_cast<float>(picture[0] + picture[1] + picture[2]);
+    pixel_reference[i] += rate * (brightness - pixel_reference[i]);
+  }
+  for (size_t i = 0; i < strip_reference.size(); ++i) {
+    strip_reference[i] += rate * (strip[i] - strip_reference[i]);
+  }
+}
+
+void LedDetector::Impl::SampleStrips(const cv::Mat& bgr, float* strip) const {
+  const size_t columns = strip_columns.size();
+  for (int y = 0; y < options.roi_px.height; ++y) {
+    const uint8_t* line = bgr.ptr<uint8_t>(options.roi_px.y + y);
+    float* out = strip + static_cast<size_t>(y) * columns;
+    for (size_t s = 0; s < columns; ++s) {
+      const uint8_t* pixel = line + 3 * strip_columns[s];
+      out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]);
+    }
+  }
+}
+
+float* LedDetector::Impl::RowGains(size_t slot) {
+  return &row_gains[slot * static_cast<size_t>(options.roi_px.height)];
+}
+
+void LedDetector::Impl::MeasureRowGains(const uint8_t* picture, const float* strip, double gain,
+                                        float* gains) {
+  const auto min_reference = static_cast<float>(3.0 * kGainMinLevels);
+  const size_t columns = strip_columns.size();
+  const auto width = static_cast<size_t>(options.roi_px.width);
+  const auto most = static_cast<float>(kRowRatioMax * gain);
+  for (int band = 0; band < GainBands(); ++band) {
+    const int y = BandRow(band);
+    const int band_end = std::min(options.roi_px.height, (band + 1) * kGainBandRows);
+    const auto band_rows = static_cast<size_t>(band_end - band * kGainBandRows);
+    const size_t samples = columns * band_rows;
+    row_ratios.clear();
+    if (columns >= kStripMinSamples) {
+      const size_t first = static_cast<size_t>(band * kGainBandRows) * columns;
+      const float* reference = &strip_reference[first];
+      const float* brightness = strip + first;
+      for (size_t s = 0; s < samples; ++s) {
+        if (reference[s] >= min_reference) row_ratios.push_back(brightness[s] / reference[s]);
+      }
+    } else {
+      const size_t first = static_cast<size_t>(y) * width;
+      for (size_t i = first; i < first + width; ++i) {
+        const uint8_t* pixel = picture + 3 * i;
+        if (pixel_reference[i] < min_reference) continue;
+        const float ratio = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / pixel_reference[i];
+        if (ratio < most) row_ratios.push_back(ratio);
+      }
+    }
+    const size_t needed = columns >= kStripMinSamples ? samples : width;
+    const float band_gain =
+        2 * row_ratios.size() > needed
+            ? MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size()))
+            : static_cast<float>(gain);
+    band_gains[static_cast<size_t>(band)] = band_gain;
+  }
+  // every row: linear between the measured rows around it
+  for (int y = 0; y < options.roi_px.height; ++y) {
+    const int band = std::clamp((y - kGainBandRows / 2) / kGainBandRows, 0, GainBands() - 1);
+    const int next = std::min(band + 1, GainBands() - 1);
+    const int from = BandRow(band), to = BandRow(next);
+    const float weight =
+        to > from
+            ? std::clamp(static_cast<float>(y - from) / static_cast<float>(to - from), 0.0f, 1.0f)
+            : 0.0f;
+    gains[y] =
+        band_gains[static_cast<size_t>(band)] +
+        weight * (band_gains[static_cast<size_t>(next)] - band_gains[static_cast<size_t>(band)]);
+  }
+}
+
+int LedDetector::Impl::BandRow(int band) const {
+  return std::min(band * kGainBandRows + kGainBandRows / 2, options.roi_px.height - 1);
+}
+
+double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gain) {
+  const cv::Rect& roi = options.roi_px;
+  uint8_t* picture = RoiPicture(slot);
+  float* strip = StripSamples(slot);
+  // the frame leaving the ring joins the references (the first frame starts them)
+  if (frames >= ring) FollowReference(picture, strip);
+  const auto row_bytes = static_cast<size_t>(roi.width) * 3;
+  for (int y = 0; y < roi.height; ++y) {
+    std::memcpy(picture + static_cast<size_t>(y) * row_bytes,
+                bgr.ptr<uint8_t>(roi.y + y) + roi.x * 3, row_bytes);
+  }
+  SampleStrips(bgr, strip);
+  if (frames == 0) {
+    reference_frames = 0;
+    std::fill(pixel_reference.begin(), pixel_reference.end(), 0.0f);
+    std::fill(strip_reference.begin(), strip_reference.end(), 0.0f);
+    FollowReference(picture, strip);
+  }
+  float* gains = RowGains(slot);
+  MeasureRowGains(picture, strip, gain, gains);
+  const auto width = static_cast<size_t>(roi.width);
+  const uint8_t* pixel = picture;
+  for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
+    changes[i] =
+        static_cast<float>(pixel[0] + pixel[1] + pixel[2]) - gains[i / width] * pixel_reference[i];
+  }
+  const auto top = static_cast<std::ptrdiff_t>(top_pixels);
+  std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end(), std::greater<>());
+  double signal = std::accumulate(changes.begin(), changes.begin() + top, 0.0);
+  std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end());
+  signal += std::accumulate(changes.begin(), changes.begin() + top, 0.0);
+  return signal;
+}
+
+bool LedDetector::Impl::SmallLightInRenewedBlock(double largest, size_t width) const {
+  const double strong = kRoiStrongFrac * largest;
+  double stepped_strong = 0.0, opposite_strong = 0.0;
+  size_t x0 = width, x1 = 0, y0 = pixel_steps.size(), y1 = 0;
+  for (size_t i = 0; i < pixel_steps.size(); ++i) {
+    if (pixel_steps[i] > strong) {
+      stepped_strong += pixel_steps[i];
+      x0 = std::min(x0, i % width);
+      x1 = std::max(x1, i % width);
+      y0 = std::min(y0, i / width);
+      y1 = std::max(y1, i / width);
+    } else if (pixel_steps[i] < -strong) {
+      opposite_strong -= pixel_steps[i];
+    }
+  }
+  const bool small = x1 >= x0 && x1 - x0 < kSmallLightPx && y1 - y0 < kSmallLightPx;
+  return small && opposite_strong <= kRoiOppositeFrac * stepped_strong;
+}
+
+bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
+  const size_t pixels = pixel_reference.size();
+  const auto frames_in_ring = static_cast<size_t>(ring);
+  const auto before = static_cast<size_t>(kBeforeFrames);
+  const auto width = static_cast<size_t>(options.roi_px.width);
+  std::vector<float> peaks(frames_in_ring);
+  double off_sum = 0.0, on_sum = 0.0;
+  for (size_t i = 0; i < pixels; ++i) {
+    float* values = &corrected[i * frames_in_ring];
+    for (size_t j = 0; j < frames_in_ring; ++j) {
+      const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
+      const uint8_t* pixel = RoiPicture(slot) + 3 * i;
+      values[j] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
+                  (RowGains(slot)[i / width] - 1.0f) * pixel_reference[i];
+      peaks[j] = static_cast<float>(std::max({pixel[0], pixel[1], pixel[2]}));
+    }
+    std::copy(values, values + frames_in_ring, window_sums.begin());
+    const double level_before = MedianOf(window_sums.data(), kBeforeFrames);
+    const double level_after =
+        MedianOf(window_sums.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+    const double peak_before = MedianOf(peaks.data(), kBeforeFrames);
+    const double peak_after =
+        MedianOf(peaks.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+    pixel_steps[i] = rise ? level_after - level_before : level_before - level_after;
+    channel_steps[i] = rise ? peak_after - peak_before : peak_before - peak_after;
+    lit_peaks[i] = rise ? peak_after : peak_before;
+    pixel_wobble[i] = std::abs(static_cast<double>(values[before - 1] - values[before - 2]));
+    off_sum += rise ? level_before : level_after;
+    on_sum += rise ? level_after : level_before;
+  }
+  // a pixel's noise (the median frame-to-frame change is 0.95 sigma for Gaussian noise)
+  const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
+  const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
+  const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
+  double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
+  for (size_t i = 0; i < pixels; ++i) {
+    if (pixel_steps[i] > clear) {
+      stepped += pixel_steps[i];
+      if (lit_peaks[i] < kClipLevels) unclipped += pixel_steps[i];
+    } else if (pixel_steps[i] < -clear) {
+      opposite -= pixel_steps[i];
+    }
+  }
+  if (stepped <= 0.0) return false;
+  if (opposite > kRoiOppositeFrac * stepped && !SmallLightInRenewedBlock(largest, width)) {
+    return false;
+  }
+  event.clipped = unclipped < kUnclippedShare * stepped;
+  // the dating dating_series and the LED's contrast over the chosen pixels
+  std::fill(dating_series.begin(), dating_series.end(), 0.0);
+  std::vector<double> contrasts;
+  for (size_t i = 0; i < pixels; ++i) {
+    if (!(pixel_steps[i] > clear)) continue;
+    contrasts.push_back(channel_steps[i]);
+    if (!event.clipped && lit_peaks[i] >= kClipLevels) continue;
+    const float* values = &corrected[i * frames_in_ring];
+    for (size_t j = 0; j < frames_in_ring; ++j) dating_series[j] += static_cast<double>(values[j]);
+  }
+  std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
+  event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
+  // the levels: the medians of the frames before and after (the pixels of a small light
+  // may still be catching up after it: the creep widens the partly lit frame's band)
+  const WindowShape shape = ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
+                                    options.threshold_frac, window_copy);
+  if (!(shape.step > 0)) return false;
+  const double widest = std::max(shape.before_spread, shape.after_against);
+  if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {
+    return false;
+  }
+  event.off = rise ? shape.before_level : shape.after_level;
+  event.on = rise ? shape.after_level : shape.before_level;
+  if (!(event.on > event.off)) return false;
+  event.noise = 0.5 * widest;
+  event.creep = shape.after_creep / (event.on - event.off);
+  event.value = dating_series;
+  event.off_levels = off_sum / (3.0 * static_cast<double>(pixels));
+  event.on_levels = on_sum / (3.0 * static_cast<double>(pixels));
+  return true;
+}
+
+int64_t LedDetector::Impl::PeriodNs() const {
+  if (interval_count == 0) return 0;
+  std::array<int64_t, kIntervalWindow> copy = intervals_ns;
+  return MedianOf(copy.data(), static_cast<int>(std::min(interval_count, kIntervalWindow)));
+}
+
+double LedDetector::Impl::OutlierJump(int64_t k) {
+  jumps.clear();
+  const int64_t last = std::min<int64_t>(k + 2, k + after_frames);
+  const auto sharp = [](double before, double previous, double next, double after) {
+    const double wobble = std::max(std::abs(previous - before), std::abs(after - next));
+    return std::max(0.0, std::abs(next - previous) - 2.0 * wobble);
+  };
+  if (located) {
+    const auto at = [&](int64_t frame) {
+      return &region_sums[Slot(frame) * static_cast<size_t>(regions)];
+    };
+    const double *before = at(k - 2), *previous = at(k - 1), *next = at(k + 1), *after = at(last);
+    const size_t count = static_cast<size_t>(regions), stride = SampleStride(count);
+    for (size_t r = 0; r < count; r += stride) {
+      jumps.push_back(sharp(before[r], previous[r], next[r], after[r]));
+    }
+  } else {
+    const auto at = [&](int64_t frame) { return &cell_sums[Slot(frame) * Cells()]; };
+    const float *before = at(k - 2), *previous = at(k - 1), *next = at(k + 1), *after = at(last);
+    const double scale = pixels_per_region / grid.sampled_px_per_cell;
+    for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
+      jumps.push_back(scale * sharp(before[c], previous[c], next[c], after[c]));
+    }
+  }
+  return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
+}
+
+double LedDetector::Impl::OutlierContrast(int64_t k) {
+  jumps.clear();
+  const uint8_t* previous = &cell_peaks[Slot(k - 1) * Cells()];
+  const uint8_t* next = &cell_peaks[Slot(k + 1) * Cells()];
+  const double previous_gain = ring_gain[Slot(k - 1)], next_gain = ring_gain[Slot(k + 1)];
+  for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
+    jumps.push_back(std::abs(next[c] / next_gain - previous[c] / previous_gain));
+  }
+  return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
+}
+
+void LedDetector::Impl::Evaluate() {
+  const int64_t k = frames - 1 - after_frames;
+  const double min_step = kMinStepLevels * 3.0 * pixels_per_region;
+  const double* next = &region_sums[Slot(k + 1) * static_cast<size_t>(regions)];
+  const double* previous = &region_sums[Slot(k - 1) * static_cast<size_t>(regions)];
+  const double* earlier = &region_sums[Slot(k - 2) * static_cast<size_t>(regions)];
+  const auto follow = static_cast<float>(1.0 / kNoiseFrames);
+  double outlier_jump = -1.0;  // computed when first needed
+  double outlier_contrast = -1.0;
+  for (int region = 0; region < regions; ++region) {
+    const auto r = static_cast<size_t>(region);
+    const double jump = next[r] - previous[r];
+    const double needed = std::max(min_step, kNoiseFactor * static_cast<double>(region_noise[r]));
+    region_noise[r] +=
+        follow * (static_cast<float>(std::abs(previous[r] - earlier[r])) - region_noise[r]);
+    // a region at a level steps only the other way, unless by far more than the step
+    // that set the level (a faint step before the LED's must not hide it)
+    const bool stronger = std::abs(jump) > kStrongerFactor * static_cast<double>(level_step[r]);
+    const bool rise = jump > needed && (level[r] != Level::kHigh || stronger);
+    const bool fall = jump < -needed && (level[r] != Level::kLow || stronger);
+    if (rise || fall) {
+      TestStep(region, k, rise, min_step, std::abs(jump), outlier_jump, outlier_contrast);
+    }
+  }
+}
+
+template <typename T>
+double LedDetector::Impl::WindowStep(const std::vector<T>& series, size_t stride, size_t offset,
+                                     int64_t k, bool rise, std::vector<T>& window) const {
+  for (int i = 0; i < ring; ++i) {
+    window[static_cast<size_t>(i)] = series[Slot(k - kBeforeFrames + i) * stride + offset];
+  }
+  const double before = MedianOf(window.data(), kBeforeFrames);
+  const double after = MedianOf(window.data() + kBeforeFrames + 1, after_frames);
+  return rise ? after - before : before - after;
+}
+
+double LedDetector::Impl::Contrast(int region, int64_t k, bool rise) {
+  const int column = region % block_columns, row = region / block_columns;
+  double contrast = 0.0;
+  for (int dy = 0; dy < 2; ++dy) {
+    for (int dx = 0; dx < 2; ++dx) {
+      const auto cell = static_cast<size_t>((row + dy) * grid.columns + column + dx);
+      const double peak_step = WindowStep(cell_peaks, Cells(), cell, k, rise, window_peaks);
+      const double mean_step = WindowStep(cell_sums, Cells(), cell, k, rise, window_sums) /
+                               (3.0 * grid.sampled_px_per_cell);
+      contrast = std::max(contrast, std::max(peak_step, mean_step));
+    }
+  }
+  return contrast;
+}
+
+void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_step, double jump,
+                                 double& outlier_jump, double& outlier_contrast) {
+  const auto at = [&](int64_t frame) {
+    return Slot(frame) * static_cast<size_t>(regions) + static_cast<size_t>(region);
+  };
+  const auto count = static_cast<size_t>(ring);
+  for (size_t i = 0; i < count; ++i) {
+    window_values[i] = region_sums[at(k - kBeforeFrames + static_cast<int64_t>(i))];
+  }
+  const auto before = window_values.cbegin();
+  const auto before_end = before + kBeforeFrames;
+  const auto after = before_end + 1;
+  const auto after_end = window_values.cend();
+  const auto [before_low, before_high] = std::minmax_element(before, before_end);
+  const auto [after_low, after_high] = std::minmax_element(after, after_end);
+  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, after_frames, rise,
+                                    options.threshold_frac, window_copy);
+  const double before_level = shape.before_level, after_level = shape.after_level;
+  const double step = shape.step;
+  const double before_spread = shape.before_spread;
+  if (step < min_step) return;
+  const double flat = FlatFrac();
+  if (before_spread > flat * step || shape.after_against > flat * step ||
+      shape.after_creep > kCreepFrac * step) {
+    return;
+  }
+  // a partly lit frame just after k is the next frame's transition: wait for it
+  if (std::abs(*after - after_level) > 0.5 * flat * step) return;
+  const double off = rise ? before_level : after_level;
+  const double threshold = off + options.threshold_frac * step;
+  if (rise ? !(*before_high<threshold&& * after_low> threshold)
+           : !(*before_low > threshold && *after_high < threshold)) {
+    return;
+  }
+  if (outlier_jump < 0) outlier_jump = OutlierJump(k);
+  if (jump < outlier_jump) return;
+
+  StepEvent event;
+  if (!located && !MeasureRoiStep(k, rise, event)) return;
+  const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
+  if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
+  if (contrast < outlier_contrast) return;
+  if (contrast < options.min_contrast_levels) {
+    if (rise && contrast > rejected_contrast) {
+      rejected_contrast = contrast;
+      rejected_region = region;
+    }
+    return;
+  }
+  if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
+
+  event.region = region;
+  event.rise = rise;
+  event.signal_step = step;
+  event.signal_off = off;
+  event.signal_on = off + step;
+  event.contrast_levels = contrast;
+  event.period_ns = PeriodNs();
+  for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
+    event.index.push_back(ring_index[Slot(frame)]);
+    event.t_ns.push_back(ring_t_ns[Slot(frame)]);
+  }
+  if (located) {
+    // the block's own sums date the step
+    event.off = off;
+    event.on = off + step;
+    event.noise = 0.5 * std::max({before_spread, shape.after_against, shape.after_creep});
+    event.off_levels = event.off / (3.0 * pixels_per_region);
+    event.on_levels = event.on / (3.0 * pixels_per_region);
+    for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
+      event.value.push_back(region_sums[at(frame)]);
+    }
+    RecordCellSteps(event, k);
+    if (!LooksLikeALight(event)) return;
+  }
+  event.frames_to_confirm = kConfirmFrames;
+  event.level_before = level[static_cast<size_t>(region)];
+  event.level_step_before = level_step[static_cast<size_t>(region)];
+  level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
+  level_step[static_cast<size_t>(region)] = static_cast<float>(step);
+  ++events_per_region[static_cast<size_t>(region)];
+  pending.push_back(std::move(event));
+}
+
+void LedDetector::Impl::RecordCellSteps(StepEvent& event, int64_t k) {
+  const int block_column = event.region % block_columns, block_row = event.region / block_columns;
+  for (int dy = 0; dy < 4; ++dy) {
+    for (int dx = 0; dx < 4; ++dx) {
+      const int column = block_column - 1 + dx, row = block_row - 1 + dy;
+      float cell_step = 0.0f;
+      if (column >= 0 && column < grid.columns && row >= 0 && row < grid.rows) {
+        const auto cell = static_cast<size_t>(row * grid.columns + column);
+        cell_step =
+            static_cast<float>(WindowStep(cell_sums, Cells(), cell, k, event.rise, window_sums));
+      }
+      event.cell_steps[static_cast<size_t>(dy * 4 + dx)] = cell_step;
+    }
+  }
+}
+
+void LedDetector::Impl::Confirm(size_t slot) {
+  size_t kept = 0;
+  for (StepEvent& event : pending) {
+    const double value =
+        region_sums[slot * static_cast<size_t>(regions) + static_cast<size_t>(event.region)];
+    const double tolerance = FlatFrac() * event.signal_step;
+    const double held = event.rise ? event.signal_on : event.signal_off;
+    const double left = event.rise ? event.signal_off : event.signal_on;
+    const double beyond = (event.rise ? 1.0 : -1.0) * (value - held);
+    const bool holds = std::abs(value - held) <= tolerance ||
+                       (beyond > 0 && beyond <= kCreepFrac * event.signal_step);
+    bool done = false;
+    if (std::abs(value - left) <= tolerance) {
+      done = true;  // back already: a short pulse
+    } else if (!holds && ++event.between > 1) {
+      level[static_cast<size_t>(event.region)] = event.level_before;
+      level_step[static_cast<size_t>(event.region)] = event.level_step_before;
+      --events_per_region[static_cast<size_t>(event.region)];
+      continue;
+    }
+    if (done || --event.frames_to_confirm <= 0) {
+      events.push_back(std::move(event));
+      continue;
+    }
+    if (&pending[kept] != &event) pending[kept] = std::move(event);
+    ++kept;
+  }
+  pending.resize(kept);
+}
+
+bool LedDetector::Impl::LooksLikeALight(const StepEvent& event) {
+  const auto cell = [&](int row, int column) {
+    return static_cast<double>(event.cell_steps[static_cast<size_t>(row * 4 + column)]);
+  };
+  const double centre = cell(1, 1) + cell(1, 2) + cell(2, 1) + cell(2, 2);
+  if (centre <= 0) return false;
+  double opposite = 0.0, largest = 0.0;
+  for (const float step : event.cell_steps) {
+    opposite += std::max(0.0, -static_cast<double>(step));
+    largest = std::max(largest, static_cast<double>(step));
+  }
+  if (opposite > kOppositeFrac * centre) return false;
+  // the widest row and the tallest column of cells that step by a good part of the most
+  int wide = 0, tall = 0;
+  for (int i = 0; i < 4; ++i) {
+    int in_row = 0, in_column = 0;
+    for (int j = 0; j < 4; ++j) {
+      in_row += cell(i, j) >= kExtentFrac * largest;
+      in_column += cell(j, i) >= kExtentFrac * largest;
+    }
+    wide = std::max(wide, in_row);
+    tall = std::max(tall, in_column);
+  }
+  return std::abs(wide - tall) < 2;
+}
+
+Status LedDetector::Impl::Process(const Frame& frame) {
+  LIFTOFF_RETURN_IF_ERROR(options_status);
+  if (frame.bgr.empty() || frame.bgr.type() != CV_8UC3) {
+    return InvalidArgumentError("frame " + std::to_string(frame.index) +
+                                ": expected an 8-bit BGR picture");
+  }
+  if (frames == 0) {
+    LIFTOFF_RETURN_IF_ERROR(Setup(frame));
+  } else {
+    if (frame.bgr.cols != width_px || frame.bgr.rows != height_px) {
+      return InvalidArgumentError("frame " + std::to_string(frame.index) + " is " +
+                                  std::to_string(frame.bgr.cols) + "x" +
+                                  std::to_string(frame.bgr.rows) + ", the first was " +
+                                  std::to_string(width_px) + "x" + std::to_string(height_px));
+    }
+    if (frame.t_ns <= last_t_ns) {
+      return InvalidArgumentError("frame " + std::to_string(frame.index) + " at " +
+                                  std::to_string(frame.t_ns) +
+                                  " ns is not after the previous frame");
+    }
+    intervals_ns[interval_count % kIntervalWindow] = frame.t_ns - last_t_ns;
+    ++interval_count;
+  }
+  last_t_ns = frame.t_ns;
+  const size_t slot = Slot(frames);
+  ring_index[slot] = frame.index;
+  ring_t_ns[slot] = frame.t_ns;
+  Measure(frame, slot);
+  Confirm(slot);
+  ++frames;
+  if (frames >= ring) Evaluate();
+  return Status::Ok();
+}
+
+LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
+  const auto exposure_ns = static_cast<double>(NsFromSeconds(options.exposure_s));
+  const ExposureRange exposure = exposure_ns > 0
+                                     ? ExposureRange{exposure_ns, exposure_ns}
+                                     : ExposureRange{0.0, static_cast<double>(event.period_ns)};
+  const double scale = event.on - event.off;
+  const double noise_fraction = event.noise / scale;
+  const double band = std::max(kFractionSigmas * noise_fraction, kFractionMargin);
+  const double lit_above = std::max(kFractionSigmas * noise_fraction, kLitFraction);
+  const auto fraction = [&](size_t i) { return (event.value[i] - event.off) / scale; };
+  // what the partly lit frame saw: its fraction within the noise band; when the LED's
+  // pixels clip, a partly lit frame looks brighter than it was, so only the upper bound
+  // holds
+  const auto lit_band = [&](double f) {
+    return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - band - event.creep),
+                       std::min(1.0, f + band)};
+  };
+  const LitFraction dark{0.0, lit_above};
+  const size_t count = event.value.size();
+  LedPulse pulse;
+  if (event.rise) {
+    // the first frame above the threshold (the before-window frames are below it), or
+    // the partly lit one just before it
+    size_t lit = kBeforeFrames;
+    for (size_t i = 0; i < count; ++i) {
+      if (fraction(i) > options.threshold_frac) {
+        lit = i;
+        break;
+      }
+    }
+    if (lit >= 2 && fraction(lit - 1) > lit_above && fraction(lit) >= 1.0 - band) --lit;
+    const double f = std::clamp(fraction(lit), 0.0, 1.0);
+    const InstantInterval interval =
+        internal::SwitchOnInterval(static_cast<double>(event.t_ns[lit - 1]), dark,
+                                   static_cast<double>(event.t_ns[lit]), lit_band(f), exposure);
+    pulse.on_ns = interval.Middle();
+    pulse.on_uncertainty_ns = interval.HalfWidth();
+    pulse.first_lit_frame = event.index[lit];
+    pulse.first_lit_fraction = f;
+  } else {
+    // the last frame above the threshold (the after-window frames are below it), or the
+    // partly lit one just after it
+    size_t lit = kBeforeFrames - 1;
+    for (size_t i = count; i-- > 0;) {
+      if (fraction(i) > options.threshold_frac) {
+        lit = i;
+        break;
+      }
+    }
+    if (lit + 2 < count && fraction(lit + 1) > lit_above && fraction(lit) >= 1.0 - band) ++lit;
+    const double f = std::clamp(fraction(lit), 0.0, 1.0);
+    const InstantInterval interval =
+        internal::SwitchOffInterval(static_cast<double>(event.t_ns[lit]), lit_band(f),
+                                    static_cast<double>(event.t_ns[lit + 1]), dark, exposure);
+    pulse.off_ns = interval.Middle();
+    pulse.off_uncertainty_ns = interval.HalfWidth();
+  }
+  return pulse;
+}
+
+cv::Rect LedDetector::Impl::LocatedRect(const StepEvent& event) const {
+  const cv::Rect block = RegionRect(event.region);
+  double weight = 0.0, x = 0.0, y = 0.0;
+  const int block_column = event.region % block_columns, block_row = event.region / block_columns;
+  for (int dy = 0; dy < 4; ++dy) {
+    for (int dx = 0; dx < 4; ++dx) {
+      const int column = block_column - 1 + dx, row = block_row - 1 + dy;
+      const double cell_step = event.cell_steps[static_cast<size_t>(dy * 4 + dx)];
+      if (cell_step <= 0 || column < 0 || row < 0 || column >= grid.columns || row >= grid.rows) {
+        continue;
+      }
+      weight += cell_step;
+      x += cell_step * (grid.x0_px[static_cast<size_t>(column)] + 0.5 * grid.cell_px);
+      y += cell_step * (grid.y0_px[static_cast<size_t>(row)] + 0.5 * grid.cell_px);
+    }
+  }
+  if (weight <= 0) return block;
+  cv::Rect rect(static_cast<int>(std::lround(x / weight - 0.5 * block.width)),
+                static_cast<int>(std::lround(y / weight - 0.5 * block.height)), block.width,
+                block.height);
+  rect.x = std::clamp(rect.x, 0, width_px - rect.width);
+  rect.y = std::clamp(rect.y, 0, height_px - rect.height);
+  return rect;
+}
+
+int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) {
+  double best_contrast = 0.0;
+  for (const StepEvent* event : steps) {
+    if (event->rise) best_contrast = std::max(best_contrast, event->contrast_levels);
+  }
+  int best = -1;
+  double best_step = 0.0;
+  for (const StepEvent* event : steps) {
+    if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
+        event->signal_step > best_step) {
+      best_step = event->signal_step;
+      best = event->region;
+    }
+  }
+  return best;
+}
+
+Result<LedResult> LedDetector::Impl::Finish() const {
+  LIFTOFF_RETURN_IF_ERROR(options_status);
+  if (frames == 0) return InvalidArgumentError("LED detector: no frame was given");
+  const std::string where =
+      located ? "anywhere in the frame" : "in the ROI " + RectText(options.roi_px);
+  // every step, confirmed or still being confirmed at the end, in the order they happened
+  std::vector<const StepEvent*> steps;
+  for (const StepEvent& event : events) steps.push_back(&event);
+  for (const StepEvent& event : pending) steps.push_back(&event);
+  std::sort(steps.begin(), steps.end(), [](const StepEvent* a, const StepEvent* b) {
+    return a->index[kBeforeFrames] < b->index[kBeforeFrames];
+  });
+  const int best = ChooseRegion(steps);
+  if (best < 0) {
     for (const StepEvent* step : steps) {
       const StepEvent& event = *step;
-      if (event.region != best || event.contrast_levels < kEligibleContrastFrac * best_contrast) {
-        continue;
-      }
       if (!event.rise) {
-        if (!first_rise_seen) already_on = true;
-        if (!result.pulses.empty() && !result.pulses.back().off_ns) {
-          const LedPulse off = DatePulse(event);
-          result.pulses.back().off_ns = off.off_ns;
-          result.pulses.back().off_uncertainty_ns = off.off_uncertainty_ns;
-        }
-        continue;
+        return NotFoundError("the LED never switches on: the only light step " + where +
+                             " goes off, at " +
+                             FormatFixed(SecondsFromNs(*DatePulse(event).off_ns), 4) +
+                             " s (was the LED already on at the start?)");
       }
-      if (!first_rise_seen) {
-        first_rise_seen = true;
-        result.off_level = event.off_levels;
-        result.on_level = event.on_levels;
-        result.contrast_levels = event.contrast_levels;
-        result.roi_px = located ? LocatedRect(event) : options.roi_px;
-      }
-      result.pulses.push_back(DatePulse(event));
     }
-    if (already_on) {
-      result.warnings.push_back(
-          "already on at the start: it went off before its first switch-on, which may have "
-          "been missed");
+    std::string message = "the LED never switches on: no brightness step " + where +
+                          " rises and holds for " + Plural(options.min_on_frames, "frame");
+    if (rejected_region >= 0) {
+      message += " with enough contrast (the best: " + FormatFixed(rejected_contrast, 0) +
+                 " grey levels at " + RectText(RegionRect(rejected_region)) +
+                 ", min_contrast_levels " + FormatFixed(options.min_contrast_levels, 0) + ")";
     }
-    if (result.contrast_levels < options.dim_warning_levels) {
-      result.warnings.push_back(
-          "dim: on-off contrast " + FormatFixed(result.contrast_levels, 0) +
-          " grey levels (expected >= " + FormatFixed(options.dim_warning_levels, 0) + ")");
-    }
-    return result;
+    return NotFoundError(message);
   }
-};
+
+  // the LED's own steps: every pulse of one LED has about the same contrast, so the
+  // region's fainter steps are something else (a shadow, a shifted edge)
+  double best_contrast = 0.0;
+  for (const StepEvent* event : steps) {
+    if (event->region == best && event->rise) {
+      best_contrast = std::max(best_contrast, event->contrast_levels);
+    }
+  }
+  LedResult result;
+  result.roi_located = located;
+  bool first_rise_seen = false;
+  bool already_on = false;
+  for (const StepEvent* step : steps) {
+    const StepEvent& event = *step;
+    if (event.region != best || event.contrast_levels < kEligibleContrastFrac * best_contrast) {
+      continue;
+    }
+    if (!event.rise) {
+      if (!first_rise_seen) already_on = true;
+      if (!result.pulses.empty() && !result.pulses.back().off_ns) {
+        const LedPulse off = DatePulse(event);
+        result.pulses.back().off_ns = off.off_ns;
+        result.pulses.back().off_uncertainty_ns = off.off_uncertainty_ns;
+      }
+      continue;
+    }
+    if (!first_rise_seen) {
+      first_rise_seen = true;
+      result.off_level = event.off_levels;
+      result.on_level = event.on_levels;
+      result.contrast_levels = event.contrast_levels;
+      result.roi_px = located ? LocatedRect(event) : options.roi_px;
+    }
+    result.pulses.push_back(DatePulse(event));
+  }
+  if (already_on) {
+    result.warnings.push_back(
+        "already on at the start: it went off before its first switch-on, which may have "
+        "been missed");
+  }
+  if (result.contrast_levels < options.dim_warning_levels) {
+    result.warnings.push_back(
+        "dim: on-off contrast " + FormatFixed(result.contrast_levels, 0) +
+        " grey levels (expected >= " + FormatFixed(options.dim_warning_levels, 0) + ")");
+  }
+  return result;
+}
 
 LedDetector::LedDetector(const Options& options) : impl_(std::make_unique<Impl>()) {
   impl_->options = options;

@@ -396,60 +396,48 @@ std::string VerificationReport::Brief() const {
          " decoded";
 }
 
-Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
-                                             const VerificationOptions& options) {
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
-  if (analysis.led.pulses.empty()) {
-    return InvalidArgumentError(DisplayPath(analysis.video_path) +
-                                ": the analysis holds no LED pulse");
-  }
-  VerificationReport report;
-  report.clip_frames = analysis.timing.frames;
-  report.foot_rest_bottom_px = analysis.foot
-                                   ? analysis.foot->foot_bottom_px - analysis.foot->rest_rise_px
-                                   : std::numeric_limits<double>::quiet_NaN();
+// ---------------------------------------------------------------------------------------
+// WriteVerification's steps
 
-  // the frames the image shows; the pass stops after the last (or runs on for a video)
-  const std::vector<Shot> led_shots = LedShots(analysis);
-  const std::vector<Shot> foot_shots = FootShots(analysis);
-  struct Kept {
-    cv::Mat bgr;
-    int64_t t_ns = 0;
-  };
-  std::map<int64_t, Kept> kept;  // the shots' frames, by index
+namespace {
+
+// a frame the image shows, kept from the second decode, by index
+struct KeptFrame {
+  cv::Mat bgr;
+  int64_t t_ns = 0;
+};
+using KeptFrames = std::map<int64_t, KeptFrame>;
+
+// The annotated video's writer: OpenCV's own Motion JPEG writer (no GStreamer or
+// image-sequence backend to try and complain about on stderr), its log quiet while it
+// opens. Left closed when no video is asked for.
+Status OpenVideoWriter(const ClipAnalysis& analysis, const VerificationOptions& options,
+                       cv::VideoWriter& writer) {
+  if (options.video_path.empty()) return Status::Ok();
+  LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options.video_path));
+  const double interval_s = SecondsFromNs(analysis.timing.median_interval_ns);
+  const double fps =
+      analysis.timing.fps > 0 ? analysis.timing.fps : (interval_s > 0 ? 1.0 / interval_s : 30.0);
+  const internal::QuietOpenCvLog quiet;
+  const bool opened = writer.open(options.video_path.string(), cv::CAP_OPENCV_MJPEG,
+                                  cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+                                  cv::Size(analysis.width_px, analysis.height_px));
+  if (!opened) {
+    return UnsupportedError(DisplayPath(options.video_path) +
+                            ": cannot write a Motion JPEG AVI there (OpenCV's writer refused)");
+  }
+  writer.set(cv::VIDEOWRITER_PROP_QUALITY, options.video_quality);
+  return Status::Ok();
+}
+
+// The second decode: each frame checked against the analysis, the `wanted` frames kept
+// for the image (when one is asked for), every frame annotated into the open writer; with
+// no video it stops after the last wanted frame.
+Status DecodeAgain(const ClipAnalysis& analysis, const std::vector<int64_t>& wanted,
+                   bool want_image, VideoReader& reader, cv::VideoWriter& writer, KeptFrames& kept,
+                   VerificationReport& report) {
   int64_t last_needed = 0;
-  for (const Shot& shot : led_shots) last_needed = std::max(last_needed, shot.frame);
-  for (const Shot& shot : foot_shots) last_needed = std::max(last_needed, shot.frame);
-
-  LIFTOFF_ASSIGN_OR_RETURN(VideoReader reader, VideoReader::Open(analysis.video_path));
-  if (reader.width_px() != analysis.width_px || reader.height_px() != analysis.height_px) {
-    return InvalidArgumentError(DisplayPath(analysis.video_path) +
-                                ": the clip's size differs from the analysis'; analyse it again");
-  }
-  cv::VideoWriter writer;
-  if (!options.video_path.empty()) {
-    LIFTOFF_RETURN_IF_ERROR(CreateParentFolder(options.video_path));
-    const double interval_s = SecondsFromNs(analysis.timing.median_interval_ns);
-    const double fps =
-        analysis.timing.fps > 0 ? analysis.timing.fps : (interval_s > 0 ? 1.0 / interval_s : 30.0);
-    // OpenCV's own Motion JPEG writer (no GStreamer or image-sequence backend to try and
-    // complain about on stderr), its log quiet while it opens
-    const internal::QuietOpenCvLog quiet;
-    const bool opened = writer.open(options.video_path.string(), cv::CAP_OPENCV_MJPEG,
-                                    cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                                    cv::Size(analysis.width_px, analysis.height_px));
-    if (!opened) {
-      return UnsupportedError(DisplayPath(options.video_path) +
-                              ": cannot write a Motion JPEG AVI there (OpenCV's writer refused)");
-    }
-    writer.set(cv::VIDEOWRITER_PROP_QUALITY, options.video_quality);
-  }
-
-  // the second decode
-  const bool want_image = !options.image_path.empty();
-  std::vector<int64_t> wanted;
-  for (const Shot& shot : led_shots) wanted.push_back(shot.frame);
-  for (const Shot& shot : foot_shots) wanted.push_back(shot.frame);
+  for (const int64_t index : wanted) last_needed = std::max(last_needed, index);
   Frame frame;
   cv::Mat annotated;
   while (true) {
@@ -476,6 +464,198 @@ Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
       break;
     }
   }
+  return Status::Ok();
+}
+
+// the image's title: the clip's name and the analysis in brief
+cv::Mat TitlePart(const ClipAnalysis& analysis, int width) {
+  cv::Mat title(58, width, CV_8UC3, kWhite);
+  Text(title, analysis.video_path.filename().string(), {10, 22}, 0.65, kBlack, 2);
+  Text(title, analysis.Brief(), {10, 46}, 0.45, kBlack);
+  return title;
+}
+
+// the LED crops, captioned, and the switch-on in words
+cv::Mat LedPart(const ClipAnalysis& analysis, const std::vector<Shot>& shots,
+                const KeptFrames& kept, const VerificationOptions& options) {
+  const cv::Size frame_size(analysis.width_px, analysis.height_px);
+  std::vector<cv::Mat> tiles;
+  const cv::Rect led_region = Grown(analysis.led.roi_px, 1.0, 8, frame_size);
+  for (const Shot& shot : shots) {
+    const auto found = kept.find(shot.frame);
+    if (found == kept.end()) continue;
+    Crop crop = MakeCrop(found->second.bgr, led_region, options.crop_height_px);
+    DrawRect(crop, analysis.led.roi_px, kRoi);
+    tiles.push_back(Captioned(crop.image, {shot.label, "frame " + std::to_string(shot.frame),
+                                           SecondsText(found->second.t_ns)}));
+  }
+  const LedPulse& pulse = analysis.led_on();
+  return Row(tiles, options.image_width_px,
+             "LED: on at " + FormatSeconds(pulse.on_ns, 4) + " s +- " +
+                 FormatFixed(1e-6 * static_cast<double>(pulse.on_uncertainty_ns), 1) +
+                 " ms (region " + std::string(analysis.led.roi_located ? "located" : "given") +
+                 ", levels off " + FormatFixed(analysis.led.off_level, 0) + " / on " +
+                 FormatFixed(analysis.led.on_level, 0) + ")");
+}
+
+// one foot crop: the region, the ground patches where the camera's shake put them, the
+// foot's where its rise did, the rest, threshold and tracked lines, and the rise in words
+cv::Mat FootTile(const FootTrack& track, const Shot& shot, const KeptFrame& frame,
+                 const cv::Rect& foot_region, int crop_height_px) {
+  const HeightSample& sample = track.samples[static_cast<size_t>(shot.frame)];
+  Crop crop = MakeCrop(frame.bgr, foot_region, crop_height_px);
+  DrawRect(crop, track.foot_roi_px, kRoi);
+  const FootLines lines = LinesAt(track, sample);
+  const double x0 = crop.Map(track.foot_roi_px.x, 0).x;
+  const double x1 = crop.Map(track.foot_roi_px.x + track.foot_roi_px.width - 1.0, 0).x;
+  const double xm0 = crop.Map(track.foot_center_x_px - 0.5 * track.foot_width_px, 0).x;
+  const double xm1 = crop.Map(track.foot_center_x_px + 0.5 * track.foot_width_px, 0).x;
+  const int shake_px = static_cast<int>(std::lround(sample.shake_y_px));
+  const int lift_px = static_cast<int>(std::lround(sample.shake_y_px - sample.rise_px));
+  for (const cv::Rect& patch : track.reference_patches_px) {
+    DrawRect(crop, patch + cv::Point(0, shake_px), kGrey);
+  }
+  for (const cv::Rect& patch : track.foot_patches_px) {
+    DrawRect(crop, patch + cv::Point(0, lift_px), kTracked);
+  }
+  HLine(crop.image, crop.Map(0, lines.rest).y, x0, x1, kRest);
+  HLine(crop.image, crop.Map(0, lines.threshold).y, x0, x1, kThreshold);
+  HLine(crop.image, crop.Map(0, lines.tracked).y, xm0, xm1, kTracked, 2);
+  const double above = sample.rise_px - track.rest_rise_px;
+  const std::string height = track.px_per_mm > 0 ? FormatFixed(above / track.px_per_mm, 2) + " mm"
+                                                 : FormatFixed(above, 2) + " px";
+  return Captioned(crop.image, {shot.label, "frame " + std::to_string(shot.frame),
+                                SecondsText(sample.t_ns), "rise " + height});
+}
+
+// the foot crops and what their colours mean
+cv::Mat FootPart(const ClipAnalysis& analysis, const std::vector<Shot>& shots,
+                 const KeptFrames& kept, const VerificationOptions& options) {
+  const FootTrack& track = *analysis.foot;
+  const cv::Size frame_size(analysis.width_px, analysis.height_px);
+  const cv::Rect foot_region = Grown(track.foot_roi_px, 0.25, 4, frame_size);
+  std::vector<cv::Mat> tiles;
+  for (const Shot& shot : shots) {
+    const auto found = kept.find(shot.frame);
+    if (found == kept.end()) continue;
+    tiles.push_back(FootTile(track, shot, found->second, foot_region, options.crop_height_px));
+  }
+  std::string heading =
+      "foot: region blue, ground patches grey, foot patches yellow (moved by the rise), rest "
+      "green, threshold red (" +
+      FormatFixed(track.threshold_px, 2) + " px";
+  if (track.px_per_mm > 0) {
+    heading += " = " + FormatFixed(track.threshold_px / track.px_per_mm, 2) + " mm";
+  }
+  heading += "); rest window " + FormatSeconds(analysis.rest_from_ns) + "-" +
+             FormatSeconds(analysis.rest_to_ns) + " s";
+  return Row(tiles, options.image_width_px, heading);
+}
+
+// close-ups of the bottom edge, enlarged until the threshold is plain to see: the rows
+// around the rest line (moved with each frame's shake), the foot's width and a margin
+cv::Mat EdgePart(const ClipAnalysis& analysis, const std::vector<Shot>& shots,
+                 const KeptFrames& kept, int width) {
+  const FootTrack& track = *analysis.foot;
+  const double rest_row = track.foot_bottom_px - track.rest_rise_px;
+  const double half_rows = std::max(6.0, 4.0 * track.threshold_px);
+  const int tiles = std::max(1, static_cast<int>(shots.size()));
+  std::vector<cv::Mat> edge_tiles;
+  for (const Shot& shot : shots) {
+    const auto found = kept.find(shot.frame);
+    if (found == kept.end()) continue;
+    const HeightSample& sample = track.samples[static_cast<size_t>(shot.frame)];
+    const double top = rest_row - half_rows + sample.shake_y_px;
+    const cv::Rect asked(
+        static_cast<int>(std::lround(track.foot_center_x_px - 0.75 * track.foot_width_px)),
+        static_cast<int>(std::lround(top)),
+        std::max(4, static_cast<int>(std::lround(1.5 * track.foot_width_px))),
+        std::max(4, static_cast<int>(std::lround(2.0 * half_rows))));
+    const cv::Rect region = asked & cv::Rect(0, 0, analysis.width_px, analysis.height_px);
+    if (region.area() == 0) continue;
+    const double fit = static_cast<double>(width - 10 * (tiles + 1)) / tiles / region.width;
+    const double scale = std::clamp(fit, 1.0, 24.0);
+    Crop crop =
+        MakeCrop(found->second.bgr, region, static_cast<int>(std::lround(region.height * scale)));
+    const FootLines lines = LinesAt(track, sample);
+    const double x1 = crop.image.cols - 1.0;
+    HLine(crop.image, crop.Map(0, lines.rest).y, 0, x1, kRest);
+    HLine(crop.image, crop.Map(0, lines.threshold).y, 0, x1, kThreshold);
+    HLine(crop.image, crop.Map(0, lines.tracked).y, 0.25 * x1, 0.75 * x1, kTracked);
+    edge_tiles.push_back(
+        Captioned(crop.image, {shot.label + ", frame " + std::to_string(shot.frame)}));
+  }
+  return Row(edge_tiles, width,
+             "the foot's bottom edge enlarged (one square per pixel): rest green, "
+             "threshold red, tracked bottom yellow");
+}
+
+// the height plots: the whole clip, then the close-up around liftoff
+cv::Mat PlotsPart(const ClipAnalysis& analysis, int width) {
+  const FootTrack& track = *analysis.foot;
+  constexpr int kPlotHeight = 230, kLeft = 60, kRight = 30, kTop = 28, kBottom = 28;
+  cv::Mat plots(2 * (kPlotHeight + kTop + kBottom), width, CV_8UC3, kWhite);
+  const cv::Rect whole(kLeft, kTop, width - kLeft - kRight, kPlotHeight);
+  const cv::Rect close(kLeft, kTop + kPlotHeight + kBottom + kTop, width - kLeft - kRight,
+                       kPlotHeight);
+  DrawHeightPanel(plots, whole, analysis, SecondsFromNs(analysis.timing.first_ns),
+                  SecondsFromNs(analysis.timing.last_ns), false, "height above rest, whole clip");
+  const double liftoff_s = SecondsFromNs(track.above_threshold.t_ns);
+  const double onset_s = SecondsFromNs(track.onset.t_ns);
+  const double interval_s = SecondsFromNs(std::max<int64_t>(analysis.timing.median_interval_ns, 1));
+  const double half_s = std::max({0.15, 10.0 * interval_s, 1.3 * (liftoff_s - onset_s)});
+  DrawHeightPanel(plots, close, analysis, liftoff_s - half_s, liftoff_s + half_s, true,
+                  "close-up around liftoff (one dot per frame)");
+  return plots;
+}
+
+// encode, then write in one go
+Status WritePng(const cv::Mat& image, const std::filesystem::path& path) {
+  std::vector<uchar> png;
+  try {
+    if (!cv::imencode(".png", image, png)) {
+      return IoError(DisplayPath(path) + ": PNG encoding failed");
+    }
+  } catch (const cv::Exception& error) {
+    return IoError(DisplayPath(path) + ": PNG encoding failed: " + error.what());
+  }
+  return WriteFileAtomically(
+      path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+}  // namespace
+
+Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
+                                             const VerificationOptions& options) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  if (analysis.led.pulses.empty()) {
+    return InvalidArgumentError(DisplayPath(analysis.video_path) +
+                                ": the analysis holds no LED pulse");
+  }
+  VerificationReport report;
+  report.clip_frames = analysis.timing.frames;
+  report.foot_rest_bottom_px = analysis.foot
+                                   ? analysis.foot->foot_bottom_px - analysis.foot->rest_rise_px
+                                   : std::numeric_limits<double>::quiet_NaN();
+
+  // the frames the image shows
+  const std::vector<Shot> led_shots = LedShots(analysis);
+  const std::vector<Shot> foot_shots = FootShots(analysis);
+  std::vector<int64_t> wanted;
+  for (const Shot& shot : led_shots) wanted.push_back(shot.frame);
+  for (const Shot& shot : foot_shots) wanted.push_back(shot.frame);
+
+  // the second decode, writing the video as it goes
+  LIFTOFF_ASSIGN_OR_RETURN(VideoReader reader, VideoReader::Open(analysis.video_path));
+  if (reader.width_px() != analysis.width_px || reader.height_px() != analysis.height_px) {
+    return InvalidArgumentError(DisplayPath(analysis.video_path) +
+                                ": the clip's size differs from the analysis'; analyse it again");
+  }
+  cv::VideoWriter writer;
+  LIFTOFF_RETURN_IF_ERROR(OpenVideoWriter(analysis, options, writer));
+  const bool want_image = !options.image_path.empty();
+  KeptFrames kept;
+  LIFTOFF_RETURN_IF_ERROR(DecodeAgain(analysis, wanted, want_image, reader, writer, kept, report));
   if (writer.isOpened()) {
     writer.release();
     report.video_path = options.video_path;
@@ -488,145 +668,15 @@ Result<VerificationReport> WriteVerification(const ClipAnalysis& analysis,
   }
   if (!want_image) return report;
 
-  // the LED crops
-  const int width = options.image_width_px;
-  const cv::Size frame_size(analysis.width_px, analysis.height_px);
-  std::vector<cv::Mat> led_tiles;
-  const cv::Rect led_region = Grown(analysis.led.roi_px, 1.0, 8, frame_size);
-  for (const Shot& shot : led_shots) {
-    const auto found = kept.find(shot.frame);
-    if (found == kept.end()) continue;
-    Crop crop = MakeCrop(found->second.bgr, led_region, options.crop_height_px);
-    DrawRect(crop, analysis.led.roi_px, kRoi);
-    led_tiles.push_back(Captioned(crop.image, {shot.label, "frame " + std::to_string(shot.frame),
-                                               SecondsText(found->second.t_ns)}));
-  }
-  const LedPulse& pulse = analysis.led_on();
-  std::vector<cv::Mat> parts;
-  {
-    cv::Mat title(58, width, CV_8UC3, kWhite);
-    Text(title, analysis.video_path.filename().string(), {10, 22}, 0.65, kBlack, 2);
-    Text(title, analysis.Brief(), {10, 46}, 0.45, kBlack);
-    parts.push_back(title);
-  }
-  parts.push_back(Row(led_tiles, width,
-                      "LED: on at " + FormatSeconds(pulse.on_ns, 4) + " s +- " +
-                          FormatFixed(1e-6 * static_cast<double>(pulse.on_uncertainty_ns), 1) +
-                          " ms (region " +
-                          std::string(analysis.led.roi_located ? "located" : "given") +
-                          ", levels off " + FormatFixed(analysis.led.off_level, 0) + " / on " +
-                          FormatFixed(analysis.led.on_level, 0) + ")"));
-
-  // the foot crops and the plots
+  // the image: title, LED, then the foot's crops, edges and plots
+  std::vector<cv::Mat> parts = {TitlePart(analysis, options.image_width_px),
+                                LedPart(analysis, led_shots, kept, options)};
   if (analysis.foot) {
-    const FootTrack& track = *analysis.foot;
-    const cv::Rect foot_region = Grown(track.foot_roi_px, 0.25, 4, frame_size);
-    std::vector<cv::Mat> foot_tiles;
-    for (const Shot& shot : foot_shots) {
-      const auto found = kept.find(shot.frame);
-      if (found == kept.end()) continue;
-      const HeightSample& sample = track.samples[static_cast<size_t>(shot.frame)];
-      Crop crop = MakeCrop(found->second.bgr, foot_region, options.crop_height_px);
-      DrawRect(crop, track.foot_roi_px, kRoi);
-      const FootLines lines = LinesAt(track, sample);
-      const double x0 = crop.Map(track.foot_roi_px.x, 0).x;
-      const double x1 = crop.Map(track.foot_roi_px.x + track.foot_roi_px.width - 1.0, 0).x;
-      const double xm0 = crop.Map(track.foot_center_x_px - 0.5 * track.foot_width_px, 0).x;
-      const double xm1 = crop.Map(track.foot_center_x_px + 0.5 * track.foot_width_px, 0).x;
-      // the ground patches where the camera's shake put them, the foot's where its rise did
-      const int shake_px = static_cast<int>(std::lround(sample.shake_y_px));
-      const int lift_px = static_cast<int>(std::lround(sample.shake_y_px - sample.rise_px));
-      for (const cv::Rect& patch : track.reference_patches_px) {
-        DrawRect(crop, patch + cv::Point(0, shake_px), kGrey);
-      }
-      for (const cv::Rect& patch : track.foot_patches_px) {
-        DrawRect(crop, patch + cv::Point(0, lift_px), kTracked);
-      }
-      HLine(crop.image, crop.Map(0, lines.rest).y, x0, x1, kRest);
-      HLine(crop.image, crop.Map(0, lines.threshold).y, x0, x1, kThreshold);
-      HLine(crop.image, crop.Map(0, lines.tracked).y, xm0, xm1, kTracked, 2);
-      const double above = sample.rise_px - track.rest_rise_px;
-      const std::string height = track.px_per_mm > 0
-                                     ? FormatFixed(above / track.px_per_mm, 2) + " mm"
-                                     : FormatFixed(above, 2) + " px";
-      foot_tiles.push_back(Captioned(crop.image, {shot.label, "frame " + std::to_string(shot.frame),
-                                                  SecondsText(sample.t_ns), "rise " + height}));
-    }
-    std::string heading =
-        "foot: region blue, ground patches grey, foot patches yellow (moved by the rise), rest "
-        "green, threshold red (" +
-        FormatFixed(track.threshold_px, 2) + " px";
-    if (track.px_per_mm > 0) {
-      heading += " = " + FormatFixed(track.threshold_px / track.px_per_mm, 2) + " mm";
-    }
-    heading += "); rest window " + FormatSeconds(analysis.rest_from_ns) +
-               "-" + FormatSeconds(analysis.rest_to_ns) + " s";
-    parts.push_back(Row(foot_tiles, width, heading));
-
-    // close-ups of the bottom edge, enlarged until the threshold is plain to see: the rows
-    // around the rest line (moved with each frame's shake), the foot's width and a margin
-    const double rest_row = track.foot_bottom_px - track.rest_rise_px;
-    const double half_rows = std::max(6.0, 4.0 * track.threshold_px);
-    const int tiles = std::max(1, static_cast<int>(foot_shots.size()));
-    std::vector<cv::Mat> edge_tiles;
-    for (const Shot& shot : foot_shots) {
-      const auto found = kept.find(shot.frame);
-      if (found == kept.end()) continue;
-      const HeightSample& sample = track.samples[static_cast<size_t>(shot.frame)];
-      const double top = rest_row - half_rows + sample.shake_y_px;
-      const cv::Rect asked(
-          static_cast<int>(std::lround(track.foot_center_x_px - 0.75 * track.foot_width_px)),
-          static_cast<int>(std::lround(top)),
-          std::max(4, static_cast<int>(std::lround(1.5 * track.foot_width_px))),
-          std::max(4, static_cast<int>(std::lround(2.0 * half_rows))));
-      const cv::Rect region = asked & cv::Rect(0, 0, frame_size.width, frame_size.height);
-      if (region.area() == 0) continue;
-      const double fit = static_cast<double>(width - 10 * (tiles + 1)) / tiles / region.width;
-      const double scale = std::clamp(fit, 1.0, 24.0);
-      Crop crop =
-          MakeCrop(found->second.bgr, region, static_cast<int>(std::lround(region.height * scale)));
-      const FootLines lines = LinesAt(track, sample);
-      const double x1 = crop.image.cols - 1.0;
-      HLine(crop.image, crop.Map(0, lines.rest).y, 0, x1, kRest);
-      HLine(crop.image, crop.Map(0, lines.threshold).y, 0, x1, kThreshold);
-      HLine(crop.image, crop.Map(0, lines.tracked).y, 0.25 * x1, 0.75 * x1, kTracked);
-      edge_tiles.push_back(
-          Captioned(crop.image, {shot.label + ", frame " + std::to_string(shot.frame)}));
-    }
-    parts.push_back(Row(edge_tiles, width,
-                        "the foot's bottom edge enlarged (one square per pixel): rest green, "
-                        "threshold red, tracked bottom yellow"));
-
-    // whole clip, then the close-up around liftoff
-    constexpr int kPlotHeight = 230, kLeft = 60, kRight = 30, kTop = 28, kBottom = 28;
-    cv::Mat plots(2 * (kPlotHeight + kTop + kBottom), width, CV_8UC3, kWhite);
-    const cv::Rect whole(kLeft, kTop, width - kLeft - kRight, kPlotHeight);
-    const cv::Rect close(kLeft, kTop + kPlotHeight + kBottom + kTop, width - kLeft - kRight,
-                         kPlotHeight);
-    DrawHeightPanel(plots, whole, analysis, SecondsFromNs(analysis.timing.first_ns),
-                    SecondsFromNs(analysis.timing.last_ns), false, "height above rest, whole clip");
-    const double liftoff_s = SecondsFromNs(track.above_threshold.t_ns);
-    const double onset_s = SecondsFromNs(track.onset.t_ns);
-    const double interval_s =
-        SecondsFromNs(std::max<int64_t>(analysis.timing.median_interval_ns, 1));
-    const double half_s = std::max({0.15, 10.0 * interval_s, 1.3 * (liftoff_s - onset_s)});
-    DrawHeightPanel(plots, close, analysis, liftoff_s - half_s, liftoff_s + half_s, true,
-                    "close-up around liftoff (one dot per frame)");
-    parts.push_back(plots);
+    parts.push_back(FootPart(analysis, foot_shots, kept, options));
+    parts.push_back(EdgePart(analysis, foot_shots, kept, options.image_width_px));
+    parts.push_back(PlotsPart(analysis, options.image_width_px));
   }
-
-  // encode, then write in one go
-  const cv::Mat image = Stack(parts);
-  std::vector<uchar> png;
-  try {
-    if (!cv::imencode(".png", image, png)) {
-      return IoError(DisplayPath(options.image_path) + ": PNG encoding failed");
-    }
-  } catch (const cv::Exception& error) {
-    return IoError(DisplayPath(options.image_path) + ": PNG encoding failed: " + error.what());
-  }
-  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(
-      options.image_path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size())));
+  LIFTOFF_RETURN_IF_ERROR(WritePng(Stack(parts), options.image_path));
   report.image_path = options.image_path;
   return report;
 }

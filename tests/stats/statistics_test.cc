@@ -53,26 +53,26 @@ TEST(Summarize, FootA2018MatchesHandComputedValues) {
   EXPECT_DOUBLE_EQ(summary.median, 0.455);
   // mean -/+ t(0.975, 4) sd / sqrt(5)
   const double half_width = 2.776445105 * stddev / std::sqrt(5.0);
-  EXPECT_NEAR(summary.ci95_low, 0.4468 - half_width, 1e-8);
-  EXPECT_NEAR(summary.ci95_high, 0.4468 + half_width, 1e-8);
-  EXPECT_NEAR(summary.ci95_low, 0.39366, 1e-5);
-  EXPECT_NEAR(summary.ci95_high, 0.49994, 1e-5);
+  EXPECT_NEAR(summary.ci_low, 0.4468 - half_width, 1e-8);
+  EXPECT_NEAR(summary.ci_high, 0.4468 + half_width, 1e-8);
+  EXPECT_NEAR(summary.ci_low, 0.39366, 1e-5);
+  EXPECT_NEAR(summary.ci_high, 0.49994, 1e-5);
   EXPECT_DOUBLE_EQ(summary.confidence, 0.95);
 }
 
 TEST(Summarize, OtherConfidenceLevelsUseTheirQuantile) {
   const Summary summary = Summarize(kFootA2018, 0.90);
   const double half_width = 2.131846786 * std::sqrt(0.0073268 / 4.0) / std::sqrt(5.0);
-  EXPECT_NEAR(summary.ci95_low, 0.4468 - half_width, 1e-8);
-  EXPECT_NEAR(summary.ci95_high, 0.4468 + half_width, 1e-8);
+  EXPECT_NEAR(summary.ci_low, 0.4468 - half_width, 1e-8);
+  EXPECT_NEAR(summary.ci_high, 0.4468 + half_width, 1e-8);
   EXPECT_DOUBLE_EQ(summary.confidence, 0.90);
 }
 
 TEST(Summarize, ConfidenceOutsideZeroToOneLeavesIntervalNaN) {
   for (double confidence : {0.0, 1.0, 1.2, -0.5}) {
     const Summary summary = Summarize(kFootA2018, confidence);
-    EXPECT_TRUE(std::isnan(summary.ci95_low)) << confidence;
-    EXPECT_TRUE(std::isnan(summary.ci95_high)) << confidence;
+    EXPECT_TRUE(std::isnan(summary.ci_low)) << confidence;
+    EXPECT_TRUE(std::isnan(summary.ci_high)) << confidence;
     EXPECT_NEAR(summary.mean, 0.4468, 1e-12);
   }
 }
@@ -86,7 +86,7 @@ TEST(Summarize, EmptySampleIsAllNaN) {
   const Summary summary = Summarize(std::vector<double>{});
   EXPECT_EQ(summary.n, 0);
   for (double value : {summary.min, summary.max, summary.mean, summary.stddev, summary.median,
-                       summary.ci95_low, summary.ci95_high}) {
+                       summary.ci_low, summary.ci_high}) {
     EXPECT_TRUE(std::isnan(value));
   }
   EXPECT_EQ(summary.Brief(), "n 0");
@@ -101,8 +101,8 @@ TEST(Summarize, SingleValueHasNoSpreadOrInterval) {
   EXPECT_DOUBLE_EQ(summary.mean, 0.422);
   EXPECT_DOUBLE_EQ(summary.median, 0.422);
   EXPECT_TRUE(std::isnan(summary.stddev));
-  EXPECT_TRUE(std::isnan(summary.ci95_low));
-  EXPECT_TRUE(std::isnan(summary.ci95_high));
+  EXPECT_TRUE(std::isnan(summary.ci_low));
+  EXPECT_TRUE(std::isnan(summary.ci_high));
 }
 
 TEST(Summarize, SkipsNonFiniteValues) {
@@ -113,8 +113,8 @@ TEST(Summarize, SkipsNonFiniteValues) {
   // deviations 0.1 and -0.1: sqrt(0.02 / 1)
   EXPECT_NEAR(summary.stddev, std::sqrt(0.02), 1e-12);
   // t(0.975, 1) = 12.7062047, sd / sqrt(2) = 0.1
-  EXPECT_NEAR(summary.ci95_low, 0.6 - 1.270620474, 1e-8);
-  EXPECT_NEAR(summary.ci95_high, 0.6 + 1.270620474, 1e-8);
+  EXPECT_NEAR(summary.ci_low, 0.6 - 1.270620474, 1e-8);
+  EXPECT_NEAR(summary.ci_high, 0.6 + 1.270620474, 1e-8);
 }
 
 TEST(Summary, BriefNamesCountMeanSpreadAndInterval) {

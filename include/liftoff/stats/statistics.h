@@ -27,9 +27,9 @@ struct Summary {
   double median = std::numeric_limits<double>::quiet_NaN();
   /// Confidence interval of the mean at `confidence` (95 % unless asked otherwise):
   /// mean -/+ t((1 + confidence) / 2, n - 1) * stddev / sqrt(n).
-  double ci95_low = std::numeric_limits<double>::quiet_NaN();
-  double ci95_high = std::numeric_limits<double>::quiet_NaN();
-  /// Confidence level of [ci95_low, ci95_high], in (0, 1).
+  double ci_low = std::numeric_limits<double>::quiet_NaN();
+  double ci_high = std::numeric_limits<double>::quiet_NaN();
+  /// Confidence level of [ci_low, ci_high], in (0, 1).
   double confidence = 0.95;
 
   /// "n 5, mean 0.4468, sd 0.0428, median 0.455, 95 % CI [0.3937, 0.4999], range

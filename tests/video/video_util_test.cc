@@ -1,0 +1,46 @@
+// The video module's shared median (src/video/video_util.h) against sorting, on seeded
+// random samples of odd and even sizes, and on the cases that take a branch of their own.
+#include "video_util.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace liftoff::video::internal {
+namespace {
+
+double SortedMedian(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
+}
+
+TEST(MedianOf, MatchesSortingOnRandomSamples) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> value(-100.0, 100.0);
+  for (size_t n = 1; n <= 40; ++n) {
+    std::vector<double> values(n);
+    for (double& v : values) v = value(rng);
+    const std::vector<double> original = values;
+    EXPECT_EQ(MedianOf(values), SortedMedian(values)) << n;
+    EXPECT_EQ(values, original) << "the vector overload keeps the caller's order";
+    EXPECT_EQ(MedianOf(values.data(), static_cast<std::ptrdiff_t>(n)), SortedMedian(original)) << n;
+  }
+}
+
+TEST(MedianOf, AveragesTheMiddleTwoAndHandlesEdges) {
+  EXPECT_EQ(MedianOf(std::vector<double>{}), 0.0);
+  EXPECT_EQ(MedianOf(std::vector<double>{4.0, 1.0}), 2.5);
+  EXPECT_EQ(MedianOf(std::vector<double>{3.0, 1.0, 2.0, 10.0}), 2.5);
+  EXPECT_EQ(MedianOf(std::vector<float>{5.0f, 5.0f, 1.0f}), 5.0f);
+  // integers: the mean of the middle two rounds toward zero
+  EXPECT_EQ(MedianOf(std::vector<int64_t>{1, 2, 3, 4}), 2);
+  std::vector<double> part = {9.0, 1.0, 5.0, -7.0, 100.0};
+  EXPECT_EQ(MedianOf(part.data(), 3), 5.0) << "only the first `count` values count";
+}
+
+}  // namespace
+}  // namespace liftoff::video::internal
