@@ -1283,6 +1283,7 @@ std::vector<cv::Rect> LedDetector::RegionsRead(cv::Size frame_px) const {
   for (const int y0 : grid.y0_px) regions.emplace_back(0, y0, frame_px.width, cell_px);
   return regions;
 }
+
 Result<LedResult> LedDetector::Finish() const { return impl_->Finish(); }
 
 }  // namespace liftoff::video
