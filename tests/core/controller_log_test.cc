@@ -243,6 +243,11 @@ TEST(ControllerLog, PackedSampleFieldsKeepTheirWholeRange) {
   EXPECT_FALSE(none.led_on.has_value());
   EXPECT_EQ(none.bend_counts, std::nullopt);
   EXPECT_EQ(std::optional<int64_t>(none.rotate_counts), std::nullopt);
+
+  // the host time's "absent" is INT64_MIN, beyond any time a log may hold
+  LogSample corrupt;
+  corrupt.host_time_ns = kMin;
+  EXPECT_FALSE(corrupt.host_time_ns.has_value());
 }
 
 TEST(ControllerLog, ToleratesAndReportsATruncatedLastLine) {

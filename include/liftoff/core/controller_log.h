@@ -29,7 +29,8 @@ inline constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 inline constexpr int64_t kMaxLogTimeNs = 4'000'000'000'000'000'000;
 
 /// A host time that may be absent, in 8 bytes: absent is INT64_MIN, which no log time
-/// takes (|time| <= kMaxLogTimeNs).
+/// takes (|time| <= kMaxLogTimeNs); storing INT64_MIN (a corrupt journal's time) leaves it
+/// absent.
 using OptionalLogTimeNs = SentinelOptional<int64_t, std::numeric_limits<int64_t>::min()>;
 
 /// One sample of the controller's stream. Fields the source did not provide are absent

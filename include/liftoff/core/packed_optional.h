@@ -7,6 +7,7 @@
 //                               padding (std::optional<int64_t> takes 16)
 //   PackedOptional<bool>        one byte (absent, false, true)
 //   SentinelOptional<T, kAbsent>  sizeof(T): one value of T, never a real one, means absent
+//                               (storing it leaves the optional absent)
 #pragma once
 
 #include <cassert>
@@ -56,17 +57,14 @@ class TriStateBool {
   uint8_t state_ = kAbsent;
 };
 
-// one value of T set aside as "absent"; storing it is a bug
+// one value of T set aside as "absent" (storing it leaves the optional absent)
 template <typename T, T kAbsent>
 class Sentinel {
  public:
   using Value = T;
   bool engaged() const { return value_ != kAbsent; }
   T get() const { return value_; }
-  void set(T value) {
-    assert(value != kAbsent && "SentinelOptional: the sentinel is not a value");
-    value_ = value;
-  }
+  void set(T value) { value_ = value; }
   void reset() { value_ = kAbsent; }
 
  private:
@@ -124,7 +122,8 @@ using PackedOptional =
     CompactOptional<std::conditional_t<std::is_same_v<T, bool>, packed_storage::TriStateBool,
                                        packed_storage::BytesAndFlag<T>>>;
 
-/// sizeof(T): `kAbsent` means absent, so it must be a value T never really takes.
+/// sizeof(T): `kAbsent` means absent (storing it leaves the optional absent), so it must
+/// be a value T never really takes.
 template <typename T, T kAbsent>
 using SentinelOptional = CompactOptional<packed_storage::Sentinel<T, kAbsent>>;
 
