@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "support/test_support.h"
 
@@ -196,6 +197,57 @@ TEST(ControllerLog, RoundTripsSamplesEventsAndMissingFieldsExactly) {
     EXPECT_EQ(read->events[i].detail, original.events[i].detail);
   }
   EXPECT_EQ(read->report.bad_lines, 0);
+}
+
+// The packed fields (LogSample is 64 bytes) keep every value the file format allows:
+// the ends of each integer's range, false apart from absent, a host time at the limit.
+TEST(ControllerLog, PackedSampleFieldsKeepTheirWholeRange) {
+  ScratchDir dir;
+  ControllerLog original;
+  const int64_t kMin = std::numeric_limits<int64_t>::min();
+  const int64_t kMax = std::numeric_limits<int64_t>::max();
+  for (int i = 0; i < 3; ++i) {
+    LogSample sample;
+    sample.device_time_ns = i;
+    if (i == 0) sample.host_time_ns = -kMaxLogTimeNs;
+    if (i == 1) sample.host_time_ns = kMaxLogTimeNs;
+    if (i != 2) sample.sequence = i == 0 ? 0u : 4'294'967'295u;
+    if (i != 2) sample.led_on = i == 1;
+    if (i != 2) sample.bend_counts = i == 0 ? kMin : kMax;
+    if (i != 2) sample.rotate_counts = i == 0 ? kMax : kMin;
+    original.samples.push_back(sample);
+  }
+  ASSERT_TRUE(WriteControllerLog(dir / "log.csv", original).ok());
+  EXPECT_THAT(ReadFile(dir / "log.csv"),
+              HasSubstr("\n0,-4000000000000000000,0,0,-9223372036854775808,9223372036854775807,"));
+
+  const Result<ControllerLog> read = ReadControllerLog(dir / "log.csv");
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  ASSERT_EQ(read->samples.size(), 3u);
+  const LogSample& low = read->samples[0];
+  EXPECT_EQ(low.host_time_ns, -kMaxLogTimeNs);
+  EXPECT_EQ(low.sequence, 0u);
+  ASSERT_TRUE(low.led_on.has_value());
+  EXPECT_FALSE(*low.led_on);
+  EXPECT_EQ(low.bend_counts, kMin);
+  EXPECT_EQ(low.rotate_counts, kMax);
+  const LogSample& high = read->samples[1];
+  EXPECT_EQ(high.host_time_ns, kMaxLogTimeNs);
+  EXPECT_EQ(high.sequence, 4'294'967'295u);
+  EXPECT_EQ(high.led_on, true);
+  EXPECT_EQ(high.bend_counts, kMax);
+  EXPECT_EQ(high.rotate_counts, kMin);
+  const LogSample& none = read->samples[2];
+  EXPECT_FALSE(none.host_time_ns.has_value());
+  EXPECT_FALSE(none.sequence.has_value());
+  EXPECT_FALSE(none.led_on.has_value());
+  EXPECT_EQ(none.bend_counts, std::nullopt);
+  EXPECT_EQ(std::optional<int64_t>(none.rotate_counts), std::nullopt);
+
+  // the host time's "absent" is INT64_MIN, beyond any time a log may hold
+  LogSample corrupt;
+  corrupt.host_time_ns = kMin;
+  EXPECT_FALSE(corrupt.host_time_ns.has_value());
 }
 
 TEST(ControllerLog, ToleratesAndReportsATruncatedLastLine) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "liftoff/core/manifest.h"
+#include "liftoff/core/packed_optional.h"
 #include "liftoff/core/status.h"
 
 namespace liftoff {
@@ -27,22 +28,28 @@ inline constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 /// log can overflow. Readers reject larger times naming file:line.
 inline constexpr int64_t kMaxLogTimeNs = 4'000'000'000'000'000'000;
 
-/// One sample of the controller's stream. Fields the source did not provide are
-/// nullopt (integers) or NaN (angles).
+/// A host time that may be absent, in 8 bytes: absent is INT64_MIN, which no log time
+/// takes (|time| <= kMaxLogTimeNs); storing INT64_MIN (a corrupt journal's time) leaves it
+/// absent.
+using OptionalLogTimeNs = SentinelOptional<int64_t, std::numeric_limits<int64_t>::min()>;
+
+/// One sample of the controller's stream. Fields the source did not provide are absent
+/// (integers, which read like std::optional) or NaN (angles). Packed into 64 bytes, as a
+/// long capture keeps millions (a 10-million-line log is 0.4-0.6 GB on disk).
 struct LogSample {
   /// Controller clock, nanoseconds from the controller's origin (the 2018 firmware's
   /// origin is the LED switch-on).
   int64_t device_time_ns = 0;
   /// Host clock when the bytes arrived, nanoseconds since the Unix epoch.
-  std::optional<int64_t> host_time_ns;
+  OptionalLogTimeNs host_time_ns;
   /// Controller's frame sequence number (wraps at 2^32).
-  std::optional<uint32_t> sequence;
+  PackedOptional<uint32_t> sequence;
   /// Sync LED state.
-  std::optional<bool> led_on;
+  PackedOptional<bool> led_on;
   /// Raw encoder counts of the bending motor (the pulled group's spool).
-  std::optional<int64_t> bend_counts;
+  PackedOptional<int64_t> bend_counts;
   /// Raw encoder counts of the rotating vertebra's motor.
-  std::optional<int64_t> rotate_counts;
+  PackedOptional<int64_t> rotate_counts;
   /// Bending spool angle, rad.
   double bend_spool_rad = kNotMeasured;
   /// Rotating motor's output-shaft angle, rad.
@@ -50,6 +57,7 @@ struct LogSample {
   /// Rotating vertebra angle (driven half relative to driving half), rad.
   double vertebra_rad = kNotMeasured;
 };
+static_assert(sizeof(LogSample) == 64, "a sample's fields pack into 64 bytes");
 
 enum class LogEventKind {
   kLedOn,      ///< the sync LED switched on
