@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <ostream>
 #include <sstream>
 
@@ -47,7 +48,7 @@ Result<EventTimes> TimesFromFlags(const SyncCommand& command) {
   for (const auto& [flag, value_s] :
        {std::pair{"--led-on", *command.led_on_s}, std::pair{"--liftoff", *command.liftoff_s},
         std::pair{"--uncertainty", command.uncertainty_s}}) {
-    LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag(flag, value_s, kTimeRange));
+    LIFTOFF_RETURN_IF_ERROR(CheckFlagRange(flag, value_s, kTimeRange, "s"));
   }
   EventTimes times;
   times.led_on_ns = NsFromSeconds(*command.led_on_s);
@@ -373,8 +374,8 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
 // liftoff log
 
 int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
-  const Status gap_checked = CheckSecondsFlag("--gap-threshold", command.gap_threshold_s,
-                                              sync::LookupOptions::kGapThresholdRange);
+  const Status gap_checked = CheckFlagRange("--gap-threshold", command.gap_threshold_s,
+                                            sync::LookupOptions::kGapThresholdRange, "s");
   if (!gap_checked.ok()) return ReportError(gap_checked, err);
   const Status bad_lines_checked = CheckMaxBadLinesFlag(command.max_bad_lines);
   if (!bad_lines_checked.ok()) return ReportError(bad_lines_checked, err);
@@ -513,6 +514,117 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err) 
     for (const auto& [field, note] : c.notes) out << "  " << field << ": " << note << '\n';
   }
   return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// the flags of each command
+
+Subcommand AddTableCommand(CLI::App& parent) {
+  auto command = std::make_shared<TableCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "table", "Rotation at liftoff per trial and the per-foot table (paper Table IV layout)");
+  app->add_option("manifest", command->manifest_path,
+                  "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
+      ->required();
+  AddCalibrationFlag(*app, command->calibration);
+  AddLookupFlags(*app, command->lookup);
+  app->add_option("--format,-f", command->format, "md, csv, latex or json")->capture_default_str();
+  app->add_option("--tables", command->tables, "both, trials or feet")->capture_default_str();
+  app->add_option("--sim", command->sim_path, "Simulation results JSON for the sim columns");
+  app->add_option("--output,-o", command->output_path, "Write here instead of stdout");
+  app->add_option("--plot", command->plot_path,
+                  "Write the hardware-vs-simulation plot here (SVG)");
+  app->add_option("--verify-dir", command->verify_dir,
+                  "Write a verification image per video-analysed trial here (<id>.png)");
+  app->add_option("--progress", command->progress,
+                  "Video analysis progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+  return {app, [command](std::ostream& out, std::ostream& err) {
+            return RunTable(*command, out, err);
+          }};
+}
+
+Subcommand AddImport2018Command(CLI::App& parent) {
+  auto command = std::make_shared<Import2018Command>();
+  CLI::App* app = parent.add_subcommand(
+      "import-2018", "Turn a 2018 Laika folder (logs + video times CSV) into a trial manifest");
+  app->add_option("folder", command->folder, "Folder with TestN*.txt and the times CSV")
+      ->required();
+  app->add_option("--output,-o", command->output_path, "Manifest to write")->required();
+  app->add_flag("--force", command->force, "Overwrite an existing manifest");
+  return {app, [command](std::ostream& out, std::ostream& err) {
+            return RunImport2018(*command, out, err);
+          }};
+}
+
+Subcommand AddSyncCommand(CLI::App& parent) {
+  auto command = std::make_shared<SyncCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "sync",
+      "Rotation at liftoff from one log and the two video instants, given or found in the clip");
+  app->add_option("log", command->log_path, "Controller log")->required();
+  CLI::Option* led_on =
+      app->add_option("--led-on", command->led_on_s, "Video time of the LED switch-on, s");
+  CLI::Option* liftoff =
+      app->add_option("--liftoff", command->liftoff_s, "Video time of the liftoff, s");
+  CLI::Option* uncertainty =
+      app->add_option("--uncertainty", command->uncertainty_s,
+                      "Timing uncertainty of each instant, s")
+          ->capture_default_str();
+  led_on->needs(liftoff);
+  liftoff->needs(led_on);
+  CLI::Option* video =
+      app->add_option("--video", command->video_path,
+                      "Find the two instants in this clip (instead of --led-on and --liftoff)")
+          ->excludes(led_on)
+          ->excludes(liftoff)
+          ->excludes(uncertainty);
+  for (CLI::Option* option : AddClipFlags(*app, command->clip)) option->needs(video);
+  app->add_option("--verify", command->verify_path,
+                  "With --video: write a verification image (PNG)")
+      ->needs(video);
+  app->add_option("--progress", command->progress,
+                  "With --video: progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+  app->add_option("--log-format", command->log_format, "auto, liftoff or laika-2018")
+      ->capture_default_str();
+  AddCalibrationFlag(*app, command->calibration);
+  AddLookupFlags(*app, command->lookup);
+  app->add_flag("--json", command->json, "JSON output");
+  return {app, [command](std::ostream& out, std::ostream& err) {
+            return RunSync(*command, out, err);
+          }};
+}
+
+Subcommand AddLogCommand(CLI::App& parent) {
+  auto command = std::make_shared<LogCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "log", "What a controller log holds; optionally convert it to liftoff's format");
+  app->add_option("log", command->log_path, "Controller log")->required();
+  app->add_option("--log-format", command->log_format, "auto, liftoff or laika-2018")
+      ->capture_default_str();
+  AddCalibrationFlag(*app, command->calibration);
+  app->add_option("--max-bad-lines", command->max_bad_lines, "Malformed lines to skip (reported)")
+      ->capture_default_str();
+  app->add_option("--gap-threshold", command->gap_threshold_s, "Gap threshold, seconds")
+      ->capture_default_str();
+  app->add_option("--convert", command->convert_path, "Write the log in liftoff's format here");
+  app->add_flag("--json", command->json, "JSON output");
+  return {app, [command](std::ostream& out, std::ostream& err) {
+            return RunLog(*command, out, err);
+          }};
+}
+
+Subcommand AddCalibCommand(CLI::App& parent) {
+  auto command = std::make_shared<CalibCommand>();
+  CLI::App* app =
+      parent.add_subcommand("calib", "Show a calibration, its provenance and its conversions");
+  app->add_option("calibration", command->calibration.calibration_path,
+                  "Calibration JSON (default: calib/laika-2018.json)");
+  app->add_flag("--json", command->json, "Print the calibration as JSON");
+  return {app, [command](std::ostream& out, std::ostream& err) {
+            return RunCalib(*command, out, err);
+          }};
 }
 
 }  // namespace liftoff::cli

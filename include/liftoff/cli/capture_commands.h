@@ -110,4 +110,10 @@ struct JournalCommand {
 };
 int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& err);
 
+/// Each command above added to the command line `parent` (flags bound to its struct).
+Subcommand AddCaptureCommand(CLI::App& parent);
+Subcommand AddEmulateCommand(CLI::App& parent);
+Subcommand AddPortsCommand(CLI::App& parent);
+Subcommand AddJournalCommand(CLI::App& parent);
+
 }  // namespace liftoff::cli

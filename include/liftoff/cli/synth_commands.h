@@ -31,4 +31,7 @@ struct SynthCommand {
 };
 int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err);
 
+/// The command added to the command line `parent` (flags bound to its struct).
+Subcommand AddSynthCommand(CLI::App& parent);
+
 }  // namespace liftoff::cli
