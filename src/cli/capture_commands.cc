@@ -280,9 +280,7 @@ Subcommand AddCaptureCommand(CLI::App& parent) {
   app->add_option("--status", command->status, "Status line: auto, live, lines or off")
       ->capture_default_str();
   AddCalibrationFlag(*app, command->calibration);
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunCapture(*command, out, err);
-          }};
+  return RunsWith(app, command, RunCapture);
 }
 
 Subcommand AddEmulateCommand(CLI::App& parent) {
@@ -314,17 +312,13 @@ Subcommand AddEmulateCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_flag("--keep-running", command->keep_running,
                 "Keep running after the test ends (until Ctrl-C or --duration)");
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunEmulate(*command, out, err);
-          }};
+  return RunsWith(app, command, RunEmulate);
 }
 
 Subcommand AddPortsCommand(CLI::App& parent) {
   auto command = std::make_shared<PortsCommand>();
   CLI::App* app = parent.add_subcommand("ports", "List the serial ports of this machine");
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunPorts(*command, out, err);
-          }};
+  return RunsWith(app, command, RunPorts);
 }
 
 Subcommand AddJournalCommand(CLI::App& parent) {
@@ -339,9 +333,7 @@ Subcommand AddJournalCommand(CLI::App& parent) {
   app->add_flag("--hex", command->hex, "Dump bytes as hexadecimal");
   app->add_option("--max-records", command->max_records, "Dump at most this many records");
   AddCalibrationFlag(*app, command->calibration);
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunJournal(*command, out, err);
-          }};
+  return RunsWith(app, command, RunJournal);
 }
 
 }  // namespace liftoff::cli

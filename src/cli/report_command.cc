@@ -642,9 +642,7 @@ Subcommand AddReportCommand(CLI::App& parent) {
   app->add_option("--gnuplot", command->gnuplot, "The gnuplot program")->capture_default_str();
   AddSweepFlags(*app, command->sweep);
   AddExperimentFlags(*app, command->sweep.experiment);  // its --progress is the report's too
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunReport(*command, out, err);
-          }};
+  return RunsWith(app, command, RunReport);
 }
 
 }  // namespace liftoff::cli

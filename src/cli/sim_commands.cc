@@ -719,9 +719,7 @@ Subcommand AddSimRunCommand(CLI::App& sim) {
   app->add_flag("--json", command->json, "JSON output");
   app->add_option("--curves", command->curves_path,
                   "Write the foot-height curves (CSV) here; - for stdout");
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunSimRun(*command, out, err);
-          }};
+  return RunsWith(app, command, RunSimRun);
 }
 
 Subcommand AddSimSweepCommand(CLI::App& sim) {
@@ -743,9 +741,7 @@ Subcommand AddSimSweepCommand(CLI::App& sim) {
       ->capture_default_str();
   AddCalibrationFlag(*app, command->calibration);
   AddLookupFlags(*app, command->lookup);
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunSimSweep(*command, out, err);
-          }};
+  return RunsWith(app, command, RunSimSweep);
 }
 
 void AddSweepFlags(CLI::App& app, SimSweepCommand& command) {
@@ -768,9 +764,7 @@ Subcommand AddSimExportMjcfCommand(CLI::App& sim) {
                 "Export the model file as written (no tension point applied)");
   AddFlags(*app, MjcfFlags(), command->mjcf);
   AddExperimentFlags(*app, command->experiment);
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunSimExportMjcf(*command, out, err);
-          }};
+  return RunsWith(app, command, RunSimExportMjcf);
 }
 
 }  // namespace liftoff::cli

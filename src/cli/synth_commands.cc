@@ -158,9 +158,7 @@ Subcommand AddSynthCommand(CLI::App& parent) {
   app->add_flag("--print-spec", command->print_spec, "Print the default spec as JSON");
   app->add_flag("--quiet,-q", command->quiet, "No progress lines on stderr");
   AddCalibrationFlag(*app, command->calibration);
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunSynth(*command, out, err);
-          }};
+  return RunsWith(app, command, RunSynth);
 }
 
 }  // namespace liftoff::cli

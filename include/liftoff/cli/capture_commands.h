@@ -1,6 +1,6 @@
 // The live-capture subcommands: `liftoff capture`, `liftoff emulate`, `liftoff ports` and
-// `liftoff journal`. Same shape as commands.h: apps/liftoff/main.cc maps flags onto these
-// option structs; each Run function writes results to `out`, diagnostics to `err`, and
+// `liftoff journal`. Same shape as commands.h: an Add function binds flags to each of
+// these option structs; each Run function writes results to `out`, diagnostics to `err`, and
 // returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
 

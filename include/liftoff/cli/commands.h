@@ -1,6 +1,6 @@
 // The liftoff command line, one Run<Command>() per subcommand, and one Add<Command>() that
-// binds its flags to its struct (CLI11, liftoff/cli/flags.h); apps/liftoff/main.cc is the
-// table of them. Tests call the Run functions directly.
+// binds its flags to its struct (CLI11, liftoff/cli/flags.h); command_table.cc lists
+// them. Tests call the Run functions directly.
 //
 // Every Run function writes results to `out`, diagnostics to `err`, and returns the
 // process exit code (ExitCodeFor; docs/cli.md). A failure never discards what was

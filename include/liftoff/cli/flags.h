@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <ostream>
@@ -276,6 +277,15 @@ struct Subcommand {
   CLI::App* app = nullptr;
   std::function<int(std::ostream& out, std::ostream& err)> run;
 };
+
+/// The Subcommand that runs `run` with `command` (the struct `app`'s flags are bound to).
+template <typename Command>
+Subcommand RunsWith(CLI::App* app, std::shared_ptr<Command> command,
+                    int (*run)(const Command&, std::ostream&, std::ostream&)) {
+  return {app, [command = std::move(command), run](std::ostream& out, std::ostream& err) {
+            return run(*command, out, err);
+          }};
+}
 
 /// Parses `argv` with `app` and runs the subcommand chosen among `commands`. Exit codes:
 /// the Run function's; usage errors kExitUsage; a FlagError its status' class; an

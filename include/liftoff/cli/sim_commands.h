@@ -1,7 +1,7 @@
 // `liftoff sim`: the simulated foot-lifting test (one run, with its height curves), the
 // tension sweep (the simulation columns of the paper's Table IV, as the results JSON the
-// table command reads), and the MJCF export. Same shape as commands.h: apps/liftoff/main.cc
-// maps flags onto these structs; each Run function writes results to `out`, progress and
+// table command reads), and the MJCF export. Same shape as commands.h: an Add function binds
+// flags to each struct; each Run function writes results to `out`, progress and
 // diagnostics to `err`, and returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
 

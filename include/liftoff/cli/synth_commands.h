@@ -1,5 +1,5 @@
 // `liftoff synth`: synthetic trials (video, controller log, ground truth) from a spec,
-// or a whole named set. Same shape as commands.h: apps/liftoff/main.cc maps flags onto
+// or a whole named set. Same shape as commands.h: AddSynthCommand binds flags to
 // SynthCommand; RunSynth writes results to `out`, progress and diagnostics to `err`, and
 // returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once

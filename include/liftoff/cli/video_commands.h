@@ -1,7 +1,7 @@
 // `liftoff video`: one clip's LED switch-on and foot liftoff, with proof (verification
 // image, annotated video); and the video parts of `liftoff table` (progress while trials'
 // videos are analysed, a verification image per analysed trial). Same shape as
-// commands.h: apps/liftoff/main.cc maps flags onto these structs; each Run function
+// commands.h: an Add function binds flags to each struct; each Run function
 // writes results to `out`, progress and diagnostics to `err`, and returns the process
 // exit code (ExitCodeFor; docs/cli.md).
 #pragma once
