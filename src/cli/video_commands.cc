@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <charconv>
 #include <iostream>
 #include <memory>
 #include <ostream>
@@ -18,6 +19,31 @@
 
 namespace liftoff::cli {
 namespace {
+
+// A region flag's "x,y,w,h" ("563,45,26,26"), px; kInvalidArgument naming the flag when
+// it is not four integers with x, y >= 0 and w, h > 0.
+Result<cv::Rect> RectFlag(std::string_view text, std::string_view flag) {
+  const auto fail = [&] {
+    return InvalidArgumentError(std::string(flag) + ": expected x,y,w,h in pixels (x, y >= 0; " +
+                                "w, h > 0), got \"" + std::string(text) + "\"");
+  };
+  int values[4] = {0, 0, 0, 0};
+  const char* at = text.data();
+  const char* end = text.data() + text.size();
+  for (int i = 0; i < 4; ++i) {
+    const auto [next, error] = std::from_chars(at, end, values[i]);
+    if (error != std::errc()) return fail();
+    at = next;
+    if (i < 3) {
+      if (at == end || *at != ',') return fail();
+      ++at;
+    }
+  }
+  if (at != end || values[0] < 0 || values[1] < 0 || values[2] <= 0 || values[3] <= 0) {
+    return fail();
+  }
+  return cv::Rect(values[0], values[1], values[2], values[3]);
+}
 
 // "FROM,TO" seconds
 Result<std::pair<double, double>> ParseRestWindow(const std::string& text) {
@@ -96,11 +122,11 @@ std::string FileStem(const std::string& id) {
 Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
   video::ClipAnalysisOptions options;
   if (!choice.led_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, video::ParseRect(choice.led_roi, "--led-roi"));
+    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, RectFlag(choice.led_roi, "--led-roi"));
   }
   if (!choice.foot_roi.empty()) {
     LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
-                             video::ParseRect(choice.foot_roi, "--foot-roi"));
+                             RectFlag(choice.foot_roi, "--foot-roi"));
   }
   if (!choice.foot.empty()) {
     const std::optional<Foot> foot = ParseFoot(choice.foot);
@@ -306,9 +332,7 @@ Subcommand AddVideoCommand(CLI::App& parent) {
   app->add_flag("--json", command->json, "JSON output");
   app->add_option("--progress", command->progress, "Progress on stderr: auto, live, lines or off")
       ->capture_default_str();
-  return {app, [command](std::ostream& out, std::ostream& err) {
-            return RunVideo(*command, out, err);
-          }};
+  return RunsWith(app, command, RunVideo);
 }
 
 }  // namespace liftoff::cli

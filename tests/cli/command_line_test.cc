@@ -13,6 +13,7 @@
 
 #include "liftoff/cli/command_table.h"
 #include "liftoff/cli/sim_commands.h"
+#include "liftoff/cli/video_commands.h"
 #include "liftoff/core/json.h"
 
 namespace liftoff::cli {
@@ -106,6 +107,23 @@ TEST(CommandLine, ExperimentFlagsShowTheExperimentsDefaultsInTheirUnits) {
           << command << " " << flag.flag;
     }
     EXPECT_NO_THROW(app.get_subcommand("report")->get_option(flag.flag)) << flag.flag;
+  }
+}
+
+TEST(ClipOptionsFrom, ReadsRegionsAsXYWHAndNamesTheFlagOtherwise) {
+  ClipChoice choice;
+  choice.led_roi = "563,45,26,27";
+  choice.foot_roi = "300,520,160,120";
+  auto options = ClipOptionsFrom(choice);
+  ASSERT_TRUE(options.ok()) << options.status().ToString();
+  EXPECT_EQ(options->led.roi_px, cv::Rect(563, 45, 26, 27));
+  EXPECT_EQ(options->foot.foot_roi_px, cv::Rect(300, 520, 160, 120));
+  for (const char* bad : {"1,2,3", "1,2,3,4,5", "1,2,0,4", "-1,2,3,4", "a,b,c,d", "1,2,3,4 "}) {
+    choice.foot_roi = bad;
+    auto parsed = ClipOptionsFrom(choice);
+    EXPECT_EQ(parsed.status().code(), StatusCode::kInvalidArgument) << bad;
+    EXPECT_THAT(parsed.status().message(), ::testing::HasSubstr("--foot-roi: expected x,y,w,h"))
+        << bad;
   }
 }
 
