@@ -43,6 +43,11 @@ Status CheckFlagRange(std::string_view flag, double value, const NumberRange& ra
                               FormatNumber(value));
 }
 
+Result<stats::TableFormat> TableFormatFlag(const std::string& text) {
+  if (const auto format = stats::ParseTableFormat(text)) return *format;
+  return InvalidArgumentError("--format: expected md, csv, latex or json, got \"" + text + "\"");
+}
+
 void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice) {
   app.add_option("--calibration,-c", choice.calibration_path,
                  "Calibration JSON (default: the manifest's, else calib/laika-2018.json)");

@@ -15,6 +15,7 @@
 #include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
 #include "liftoff/core/output.h"
+#include "liftoff/stats/table.h"
 #include "liftoff/sync/lookup.h"
 #include "liftoff/sync/trial_analysis.h"
 
@@ -33,6 +34,10 @@ Status CheckFlagRange(std::string_view flag, double value, const NumberRange& ra
 
 /// OK when `--max-bad-lines` is >= 0, else kInvalidArgument naming the flag.
 Status CheckMaxBadLinesFlag(int64_t max_bad_lines);
+
+/// A table command's --format; kInvalidArgument "--format: expected md, csv, latex or
+/// json, got ..." for another word.
+Result<stats::TableFormat> TableFormatFlag(const std::string& text);
 
 /// --calibration (-c), bound to `choice`.
 void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice);

@@ -575,11 +575,8 @@ Result<sim::SweepResult> RunSweepShowingProgress(const SimSweepCommand& command,
 }
 
 int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
-  const auto table_format = stats::ParseTableFormat(command.format);
-  if (!table_format) {
-    return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
-                                            command.format + "\""),
-                       err);
+  if (const auto checked = TableFormatFlag(command.format); !checked.ok()) {
+    return ReportError(checked.status(), err);
   }
   // the hardware trials are read before the sweep: a missing or broken manifest fails in
   // a second, not after the whole sweep

@@ -130,12 +130,8 @@ Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_p
 
 int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) {
   // flags
-  const auto format = stats::ParseTableFormat(command.format);
-  if (!format) {
-    return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
-                                            command.format + "\""),
-                       err);
-  }
+  const auto format = TableFormatFlag(command.format);
+  if (!format.ok()) return ReportError(format.status(), err);
   if (command.tables != "both" && command.tables != "trials" && command.tables != "feet") {
     return ReportError(InvalidArgumentError("--tables: expected both, trials or feet, got \"" +
                                             command.tables + "\""),
