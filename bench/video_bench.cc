@@ -135,11 +135,18 @@ int RunDecodeChild(const char* video) {
   return frames > 0 ? 0 : 1;
 }
 
+// "x,y,w,h" as RectText below writes it
+cv::Rect RectFromText(const char* text) {
+  int x = 0, y = 0, width = 0, height = 0;
+  std::sscanf(text, "%d,%d,%d,%d", &x, &y, &width, &height);
+  return {x, y, width, height};
+}
+
 // child mode: analyse one clip and exit (the parent reads our peak memory)
 int RunChild(const char* video, const char* led, const char* foot, const char* px_per_mm) {
   video::ClipAnalysisOptions options;
-  options.led.roi_px = *video::ParseRect(led, "led");
-  options.foot.foot_roi_px = *video::ParseRect(foot, "foot");
+  options.led.roi_px = RectFromText(led);
+  options.foot.foot_roi_px = RectFromText(foot);
   options.foot.px_per_mm = std::atof(px_per_mm);
   auto analysis = video::AnalyzeClip(video, options);
   if (!analysis.ok()) {

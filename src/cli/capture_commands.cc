@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <iostream>
 #include <numbers>
+#include <memory>
 #include <ostream>
 
 #include "cli_common.h"
+#include "liftoff/cli/progress_line.h"
 #include "liftoff/capture/capture_session.h"
 #include "liftoff/capture/emulator.h"
 #include "liftoff/capture/journal.h"
@@ -95,15 +97,8 @@ std::string StatusText(const capture::CaptureStatus& status) {
 
 int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& err) {
   // flags
-  const bool live =
-      command.status == "live" || (command.status == "auto" && err.rdbuf() == std::cerr.rdbuf() &&
-                                   ::isatty(STDERR_FILENO) == 1);
-  if (command.status != "auto" && command.status != "live" && command.status != "lines" &&
-      command.status != "off") {
-    return ReportError(InvalidArgumentError("--status: expected auto, live, lines or off, got \"" +
-                                            command.status + "\""),
-                       err);
-  }
+  auto status_line = ProgressLine::Create(command.status, "--status", "capture", err);
+  if (!status_line.ok()) return ReportError(status_line.status(), err);
   capture::CaptureOptions options;
   options.port = command.port;
   options.settings.baud_rate = command.baud_rate;
@@ -114,7 +109,7 @@ int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& e
   options.first_frame_timeout_s = command.first_frame_timeout_s;
   options.stop_on_test_end = !command.no_stop_on_test_end;
   options.reconnect_poll_s = command.reconnect_poll_s;
-  options.status_interval_s = live ? 0.25 : 5.0;
+  options.status_interval_s = status_line->live() ? 0.25 : 5.0;
   if (command.send_start) {
     auto test = TestParametersFrom(command.test);
     if (!test.ok()) return ReportError(test.status(), err);
@@ -128,25 +123,14 @@ int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& e
 
   // the capture, with a status line and Ctrl-C as a clean stop
   ScopedStopSignals signals(command.handle_signals);
-  size_t last_width = 0;
   std::function<void(const capture::CaptureStatus&)> on_status;
-  if (command.status != "off") {
-    on_status = [&](const capture::CaptureStatus& status) {
-      const std::string text = StatusText(status);
-      if (live) {
-        err << '\r' << text
-            << std::string(last_width > text.size() ? last_width - text.size() : 0, ' ')
-            << std::flush;
-        last_width = text.size();
-      } else {
-        err << "capture: " << text << std::endl;
-      }
-    };
+  if (!status_line->off()) {
+    on_status = [&](const capture::CaptureStatus& status) { status_line->Show(StatusText(status)); };
   }
   err << "capturing " << command.port << " -> " << options.log_path.string() << " (journal "
       << options.JournalPath().string() << "); Ctrl-C stops\n";
   auto summary = capture::RunCapture(options, *calibration, g_stop_requested, on_status);
-  if (live && last_width > 0) err << '\n';
+  status_line->Keep();
   if (!summary.ok()) return ReportError(summary.status(), err);
 
   for (const std::string& warning : summary->warnings) err << "warning: " << warning << '\n';
@@ -248,6 +232,108 @@ int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& e
   if (!written.ok()) return ReportError(written, err);
   err << "wrote " << command.output_path.string() << '\n';
   return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// the flags of each command
+
+namespace {
+
+void AddTestFlags(CLI::App& app, TestChoice& test) {
+  app.add_option("--pulled", test.pulled_group, "Cable group the bend pulls: HR or HL")
+      ->capture_default_str();
+  app.add_option("--bend-percent", test.bend_percent,
+                 "Bend each cable of the group to this percentage of its rest length")
+      ->capture_default_str();
+  app.add_option("--ramp-deg", test.ramp_deg,
+                 "Rotating vertebra's ramp amplitude, degrees, signed by direction")
+      ->capture_default_str();
+  app.add_option("--ramp-s", test.ramp_s, "Ramp duration, seconds")->capture_default_str();
+}
+
+}  // namespace
+
+Subcommand AddCaptureCommand(CLI::App& parent) {
+  auto command = std::make_shared<CaptureCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "capture", "Record a test from the controller's serial port: raw journal + controller log");
+  app->add_option("port", command->port, "Serial port: device path, stable id or symlink")
+      ->required();
+  app->add_option("--output,-o", command->log_path, "Controller log to write")->required();
+  app->add_option("--journal", command->journal_path, "Raw journal (default: LOG.journal)");
+  app->add_flag("--force", command->force,
+                "Replace an existing log and journal (an earlier recording)");
+  app->add_option("--baud", command->baud_rate, "Line speed, bits/s")->capture_default_str();
+  app->add_flag("--start", command->send_start,
+                "Send START with the test parameters and record them in the log");
+  AddTestFlags(*app, command->test);
+  app->add_option("--max-duration", command->max_duration_s, "Stop after this long, s")
+      ->capture_default_str();
+  app->add_option("--first-frame-timeout", command->first_frame_timeout_s,
+                  "Fail when no frame arrives this long after opening, s (0: wait for ever)")
+      ->capture_default_str();
+  app->add_flag("--no-stop-on-test-end", command->no_stop_on_test_end,
+                "Keep capturing after the controller's TEST_END");
+  app->add_option("--reconnect-poll", command->reconnect_poll_s,
+                  "Look for an unplugged port this often, s")
+      ->capture_default_str();
+  app->add_option("--status", command->status, "Status line: auto, live, lines or off")
+      ->capture_default_str();
+  AddCalibrationFlag(*app, command->calibration);
+  return RunsWith(app, command, RunCapture);
+}
+
+Subcommand AddEmulateCommand(CLI::App& parent) {
+  auto command = std::make_shared<EmulateCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "emulate", "A test controller on a pseudo-terminal (prints its path), with fault injection");
+  app->add_option("--rate", command->rate_hz, "Sample frames per second")->capture_default_str();
+  app->add_flag("--unpaced", command->unpaced, "Send as fast as the reader takes frames");
+  app->add_flag("--autostart", command->autostart, "Start the test without a START command");
+  AddTestFlags(*app, command->test);
+  app->add_option("--link", command->link_path,
+                  "Stable symlink to the pseudo-terminal (kept across disconnects)");
+  app->add_option("--corrupt", command->corrupt_probability,
+                  "Probability that a byte gets a bit flipped")
+      ->capture_default_str();
+  app->add_option("--drop", command->drop_probability, "Probability that a frame is dropped")
+      ->capture_default_str();
+  app->add_option("--stall-at", command->stall_at_s, "Pause the output at this time, s");
+  app->add_option("--stall-for", command->stall_for_s, "... for this long, s")
+      ->capture_default_str();
+  app->add_option("--disconnect-at", command->disconnect_at_s,
+                  "Unplug at this time, s (needs --link)");
+  app->add_option("--disconnect-for", command->disconnect_for_s, "... for this long, s")
+      ->capture_default_str();
+  app->add_option("--drift-ppm", command->drift_ppm, "Device clock rate error, ppm")
+      ->capture_default_str();
+  app->add_option("--seed", command->seed, "Seed of the fault generator")->capture_default_str();
+  app->add_option("--duration", command->duration_s, "Run this long, s (0: until done)")
+      ->capture_default_str();
+  app->add_flag("--keep-running", command->keep_running,
+                "Keep running after the test ends (until Ctrl-C or --duration)");
+  return RunsWith(app, command, RunEmulate);
+}
+
+Subcommand AddPortsCommand(CLI::App& parent) {
+  auto command = std::make_shared<PortsCommand>();
+  CLI::App* app = parent.add_subcommand("ports", "List the serial ports of this machine");
+  return RunsWith(app, command, RunPorts);
+}
+
+Subcommand AddJournalCommand(CLI::App& parent) {
+  auto command = std::make_shared<JournalCommand>();
+  CLI::App* app =
+      parent.add_subcommand("journal", "Show a capture journal, or rebuild its controller log");
+  app->add_option("journal", command->journal_path, "Capture journal")->required();
+  app->add_flag("--replay", command->replay,
+                "Rebuild the controller log with live capture's parsing");
+  app->add_option("--output,-o", command->output_path, "With --replay: log to write");
+  app->add_flag("--force", command->force, "Overwrite an existing output file");
+  app->add_flag("--hex", command->hex, "Dump bytes as hexadecimal");
+  app->add_option("--max-records", command->max_records, "Dump at most this many records");
+  AddCalibrationFlag(*app, command->calibration);
+  return RunsWith(app, command, RunJournal);
 }
 
 }  // namespace liftoff::cli

@@ -35,10 +35,38 @@ Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
   return LoadCalibration(path);
 }
 
-Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange& range) {
-  if (InNumberRange(value_s, range)) return Status::Ok();
+Status CheckFlagRange(std::string_view flag, double value, const NumberRange& range,
+                      std::string_view unit) {
+  if (InNumberRange(value, range)) return Status::Ok();
   return InvalidArgumentError(std::string(flag) + ": expected " + DescribeNumberRange(range) +
-                              " s, got " + FormatNumber(value_s));
+                              (unit.empty() ? "" : " ") + std::string(unit) + ", got " +
+                              FormatNumber(value));
+}
+
+Result<stats::TableFormat> TableFormatFlag(const std::string& text) {
+  if (const auto format = stats::ParseTableFormat(text)) return *format;
+  return InvalidArgumentError("--format: expected md, csv, latex or json, got \"" + text + "\"");
+}
+
+void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice) {
+  app.add_option("--calibration,-c", choice.calibration_path,
+                 "Calibration JSON (default: the manifest's, else calib/laika-2018.json)");
+}
+
+void AddLookupFlags(CLI::App& app, LookupChoice& lookup) {
+  app.add_option("--rule", lookup.rule,
+                 "Angle lookup: linear (interpolate) or hold (last sample at or before, the "
+                 "2018 authors' rule)")
+      ->capture_default_str();
+  app.add_option("--gap-threshold", lookup.gap_threshold_s,
+                 "Samples further apart than this bracket a gap, seconds")
+      ->capture_default_str();
+  app.add_option("--max-past-end", lookup.max_past_end_s,
+                 "Answer lookups up to this far past the log's last sample, seconds")
+      ->capture_default_str();
+  app.add_option("--max-bad-lines", lookup.max_bad_lines,
+                 "Malformed log lines to skip (reported) before a log is rejected")
+      ->capture_default_str();
 }
 
 Status CheckMaxBadLinesFlag(int64_t max_bad_lines) {
@@ -55,10 +83,10 @@ Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
     return InvalidArgumentError("--rule: expected linear or hold, got \"" + choice.rule + "\"");
   }
   options.rule = *rule;
-  LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag("--gap-threshold", choice.gap_threshold_s,
-                                           sync::LookupOptions::kGapThresholdRange));
-  LIFTOFF_RETURN_IF_ERROR(CheckSecondsFlag("--max-past-end", choice.max_past_end_s,
-                                           sync::LookupOptions::kMaxPastEndRange));
+  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--gap-threshold", choice.gap_threshold_s,
+                                         sync::LookupOptions::kGapThresholdRange, "s"));
+  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--max-past-end", choice.max_past_end_s,
+                                         sync::LookupOptions::kMaxPastEndRange, "s"));
   options.gap_threshold_s = choice.gap_threshold_s;
   options.max_past_end_s = choice.max_past_end_s;
   LIFTOFF_RETURN_IF_ERROR(options.Validate());

@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/flags.h"
 #include "liftoff/core/calibration.h"
 #include "liftoff/core/controller_log.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/manifest.h"
 #include "liftoff/core/output.h"
+#include "liftoff/stats/table.h"
 #include "liftoff/sync/lookup.h"
 #include "liftoff/sync/trial_analysis.h"
 
@@ -24,12 +26,26 @@ namespace liftoff::cli {
 Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
                                       const std::filesystem::path& manifest_choice = {});
 
-/// OK when `value_s` lies in `range`, else kInvalidArgument naming the flag:
-/// "--max-past-end: expected a number in [0, 1e+06] s, got 1e+10".
-Status CheckSecondsFlag(std::string_view flag, double value_s, const NumberRange& range);
+/// OK when `value` lies in `range`, else kInvalidArgument naming the flag and `unit`:
+/// "--max-past-end: expected a number in [0, 1e+06] s, got 1e+10". For flags that are no
+/// option struct's field (those are checked by the struct's Validate()).
+Status CheckFlagRange(std::string_view flag, double value, const NumberRange& range,
+                      std::string_view unit = "");
 
 /// OK when `--max-bad-lines` is >= 0, else kInvalidArgument naming the flag.
 Status CheckMaxBadLinesFlag(int64_t max_bad_lines);
+
+/// A table command's --format; kInvalidArgument "--format: expected md, csv, latex or
+/// json, got ..." for another word.
+Result<stats::TableFormat> TableFormatFlag(const std::string& text);
+
+/// --calibration (-c), bound to `choice`.
+void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice);
+/// --rule, --gap-threshold, --max-past-end, --max-bad-lines, bound to `lookup`.
+void AddLookupFlags(CLI::App& app, LookupChoice& lookup);
+/// The clip analysis' flags (`video`, `sync --video`): regions, foot, scale, threshold and
+/// exposure, bound to `clip`; returned so a mode flag can require or exclude them.
+std::vector<CLI::Option*> AddClipFlags(CLI::App& app, ClipChoice& clip);
 
 /// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <map>
 #include <optional>
+#include <memory>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -112,7 +113,8 @@ Result<std::string> CacheKey(const ReportCommand& command, const Calibration& ca
   const std::string key_text = "model\n" + model + "\ncalibration\n" +
                                CalibrationToJson(calibration).dump() + "\nexperiment\n" +
                                DescribeOverrides(command.sweep.experiment) + "\nfeet\n" +
-                               command.sweep.feet + "\ntensions\n" + command.sweep.tensions +
+                               Join(command.sweep.feet, ",") + "\ntensions\n" +
+                               Join(command.sweep.tensions, ",") +
                                "\nfull_ramp\n" + (command.sweep.full_ramp ? "1" : "0") +
                                "\nversion\n" + kVersion;
   return HashHex(key_text);
@@ -647,6 +649,45 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
     return ExitCodeFor(campaign->first_failure.code());
   }
   return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// the flags
+
+Subcommand AddReportCommand(CLI::App& parent) {
+  auto command = std::make_shared<ReportCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "report",
+      "The campaign in one folder: every trial, the simulated column (cached), the tables, the "
+      "figures (gnuplot), report.md and report.html");
+  app->add_option("manifest", command->manifest_path,
+                  "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
+      ->required();
+  app->add_option("--output,-o", command->output_dir, "Folder to write the report in")
+      ->required();
+  AddCalibrationFlag(*app, command->calibration);
+  AddLookupFlags(*app, command->lookup);
+  app->add_flag("--no-sim", command->no_sim, "Leave the simulation out");
+  app->add_option("--cache-dir", command->cache_dir,
+                  "Cached sweeps (<key>.json) here (default: DIR/sim-cache)");
+  app->add_option("--gnuplot", command->gnuplot, "The gnuplot program")->capture_default_str();
+  AddSweepFlags(*app, command->sweep);
+  AddExperimentFlags(*app, command->sweep.experiment);  // its --progress is the report's too
+  app->add_option("--fit-min", command->fit.sigma_min, "Tension scale fitted from (sigma)")
+      ->capture_default_str();
+  app->add_option("--fit-max", command->fit.sigma_max, "... to (sigma)")->capture_default_str();
+  app->add_option("--fit-step", command->fit.sigma_step, "Simulated every (sigma)")
+      ->capture_default_str();
+  app->add_option("--bootstrap", command->fit.bootstrap_samples, "Bootstrap resamples of the fit")
+      ->capture_default_str();
+  app->add_option("--mc-samples", command->monte_carlo.samples,
+                  "Monte Carlo draws of the spring constants (0: none)")
+      ->capture_default_str();
+  app->add_option("--mc-seed", command->monte_carlo.seed, "Monte Carlo seed")->capture_default_str();
+  app->add_option("--mc-sd-scale", command->monte_carlo.stddev_scale,
+                  "Monte Carlo: Table I's standard deviations times this")
+      ->capture_default_str();
+  return RunsWith(app, command, RunReport);
 }
 
 }  // namespace liftoff::cli

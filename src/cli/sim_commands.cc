@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <ostream>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "liftoff/cli/progress_line.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
@@ -29,64 +31,8 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
-
 // ---------------------------------------------------------------------------------------
 // flags
-
-Status CheckFlag(std::string_view flag, double value, const NumberRange& range,
-                 std::string_view unit) {
-  if (InNumberRange(value, range)) return Status::Ok();
-  return InvalidArgumentError(std::string(flag) + ": expected " + DescribeNumberRange(range) +
-                              (unit.empty() ? "" : " " + std::string(unit)) + ", got " +
-                              FormatNumber(value));
-}
-
-// Checks an optional flag and stores value * scale into `target` when given.
-Status TakeFlag(std::string_view flag, const std::optional<double>& value, const NumberRange& range,
-                std::string_view unit, double scale, double& target) {
-  if (!value) return Status::Ok();
-  LIFTOFF_RETURN_IF_ERROR(CheckFlag(flag, *value, range, unit));
-  target = *value * scale;
-  return Status::Ok();
-}
-
-std::vector<std::string> SplitCommas(std::string_view text) {
-  std::vector<std::string> parts;
-  size_t start = 0;
-  while (true) {
-    const size_t comma = text.find(',', start);
-    parts.emplace_back(text.substr(start, comma == std::string_view::npos ? comma : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return parts;
-}
-
-// "a,b,c" as exactly `count` numbers; kInvalidArgument naming the flag otherwise.
-Result<std::vector<double>> NumberList(std::string_view flag, std::string_view text, size_t count,
-                                       std::string_view expected) {
-  std::vector<double> values;
-  for (const std::string& part : SplitCommas(text)) {
-    size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(part, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != part.size() || !std::isfinite(value)) {
-      values.clear();
-      break;
-    }
-    values.push_back(value);
-  }
-  if (values.size() != count) {
-    return InvalidArgumentError(std::string(flag) + ": expected " + std::string(expected) +
-                                ", got \"" + std::string(text) + "\"");
-  }
-  return values;
-}
 
 Result<Foot> FootFlag(std::string_view flag, std::string_view text) {
   if (auto foot = ParseFoot(text)) return *foot;
@@ -104,47 +50,25 @@ Result<TensionPoint> TensionFlag(std::string_view text) {
   return point;
 }
 
-// The test's tension point: explicit stiffnesses, else a paper point by name or index.
-Result<TensionPoint> RunTensionPoint(const std::string& tension, const std::string& stiffness) {
-  if (stiffness.empty()) return TensionFlag(tension);
-  LIFTOFF_ASSIGN_OR_RETURN(
-      std::vector<double> values,
-      NumberList("--stiffness", stiffness, 3, "SILICONE,BUNA_N,SPRING in N/m, e.g. 258,1073,187"));
-  for (double value : values) {
-    if (!(value > 0.0)) {
-      return InvalidArgumentError("--stiffness: expected three numbers > 0 N/m, got \"" +
-                                  stiffness + "\"");
-    }
+// The test's tension point: explicit stiffnesses (checked by ExperimentOptions::Validate),
+// else a paper point by name or index.
+Result<TensionPoint> RunTensionPoint(const std::string& tension,
+                                     const std::vector<double>& stiffness_n_per_m) {
+  if (stiffness_n_per_m.empty()) return TensionFlag(tension);
+  if (stiffness_n_per_m.size() != 3) {
+    return InvalidArgumentError(
+        "--stiffness: expected SILICONE,BUNA_N,SPRING in N/m, e.g. 258,1073,187, got " +
+        Plural(static_cast<int64_t>(stiffness_n_per_m.size()), "number"));
   }
-  return TensionPoint{"custom", 0.0, values[0], values[1], values[2]};
-}
-
-// A Validate() message starts with the option's field name; name the flag instead.
-Status RenameFields(const Status& status) {
-  static const std::array<std::pair<std::string_view, std::string_view>, 15> kFlags = {{
-      {"reference_time_s", "--reference-s"},
-      {"sample_period_s", "--sample-period-s"},
-      {"ramp_start_s", "--ramp-start-s"},
-      {"ramp_duration_s", "--ramp-s"},
-      {"bend_start_s", "--bend-start-s"},
-      {"bend_fraction", "--bend-fraction"},
-      {"bend_speed_m_per_s", "--bend-speed"},
-      {"drop_height_m", "--drop-height-m"},
-      {"friction", "--friction"},
-      {"engine: time_step_s", "--dt"},
-      {"engine: solver_iterations", "--solver-iterations"},
-      {"engine: contact_bias", "--contact-bias"},
-      {"cable_damping_n_s_per_m", "--damping"},
-      {"spine_friction", "--spine-friction"},
-      {"foot_marker_height_m", "--marker-height-m"},
-  }};
-  const std::string& message = status.message();
-  for (const auto& [field, flag] : kFlags) {
-    if (message.rfind(std::string(field) + ":", 0) == 0) {
-      return Status(status.code(), std::string(flag) + message.substr(field.size()));
-    }
+  sim::ExperimentOptions checked;
+  checked.tension_point = TensionPoint{"custom", 0.0, stiffness_n_per_m[0],
+                                       stiffness_n_per_m[1], stiffness_n_per_m[2]};
+  const Status valid = checked.Validate();
+  if (auto named = MessageNamingFlag(valid.message(), "--stiffness", "tension_point", true)) {
+    return InvalidArgumentError(*named);
   }
-  return status.WithContext("simulation options");
+  LIFTOFF_RETURN_IF_ERROR(valid);
+  return *checked.tension_point;
 }
 
 Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice) {
@@ -159,82 +83,45 @@ Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice)
 class SimProgress {
  public:
   static Result<SimProgress> Create(std::string_view mode, std::ostream& err) {
-    if (mode != "auto" && mode != "live" && mode != "lines" && mode != "off") {
-      return InvalidArgumentError("--progress: expected auto, live, lines or off, got \"" +
-                                  std::string(mode) + "\"");
-    }
-    const bool live = mode == "live" || (mode == "auto" && err.rdbuf() == std::cerr.rdbuf() &&
-                                         ::isatty(STDERR_FILENO) == 1);
-    return SimProgress(err, live, mode == "off");
+    LIFTOFF_ASSIGN_OR_RETURN(ProgressLine line, ProgressLine::Create(mode, "--progress", "sim", err));
+    return SimProgress(std::move(line));
   }
 
   // One run: simulated time and rotation.
   void ShowRun(std::string_view label, const sim::RunProgress& progress) {
-    if (off_ || !Due()) return;
-    const std::string text = std::string(label) + ": t " + FormatFixed(progress.time_s, 1) +
-                             " of " + FormatFixed(progress.end_time_s, 1) +
-                             " s simulated, rotation " + FormatFixed(progress.hinge_angle_rad, 3) +
-                             " rad";
-    if (live_) {
-      Rewrite(text);
-    } else {
-      *err_ << "sim: " << text << std::endl;
-    }
+    if (line_.off() || !line_.Due()) return;
+    line_.Show(std::string(label) + ": t " + FormatFixed(progress.time_s, 1) + " of " +
+               FormatFixed(progress.end_time_s, 1) + " s simulated, rotation " +
+               FormatFixed(progress.hinge_angle_rad, 3) + " rad");
   }
 
   // The sweep: the runs under way, and a line for each finished run.
   void ShowSweep(const sim::SweepProgress& progress) {
-    if (off_) return;
     if (progress.finished != nullptr) {
       active_.erase(progress.run_index);
-      Clear();
-      *err_ << "sim: [" << progress.runs_done << "/" << progress.runs_total << "] "
-            << progress.finished->Brief() << std::endl;
+      line_.Line("[" + std::to_string(progress.runs_done) + "/" +
+                 std::to_string(progress.runs_total) + "] " + progress.finished->Brief());
       return;
     }
     active_[progress.run_index] = {
         std::string(FootName(progress.foot)) + " " + progress.tension_point->name, progress.run};
-    if (!live_ || !Due()) return;
+    if (!line_.live() || !line_.Due()) return;
     std::string text = "sim sweep: " + std::to_string(progress.runs_done) + "/" +
                        std::to_string(progress.runs_total) + " done";
     for (const auto& [index, run] : active_) {
       text += " | " + run.first + " t " + FormatFixed(run.second.time_s, 1) + " s " +
               FormatFixed(run.second.hinge_angle_rad, 3) + " rad";
     }
-    Rewrite(text);
+    line_.Show(text);
   }
 
   // Ends a live line (call before printing anything else).
-  void Done() { Clear(); }
+  void Done() { line_.Clear(); }
 
  private:
-  SimProgress(std::ostream& err, bool live, bool off)
-      : err_(&err), live_(live), off_(off), last_shown_ns_(MonotonicNowNs()) {}
+  explicit SimProgress(ProgressLine line) : line_(std::move(line)) {}
 
-  bool Due() {
-    const int64_t now_ns = MonotonicNowNs();
-    const int64_t every_ns = live_ ? NsFromMilliseconds(200) : NsFromSeconds(5.0);
-    if (now_ns - last_shown_ns_ < every_ns) return false;
-    last_shown_ns_ = now_ns;
-    return true;
-  }
-  void Rewrite(const std::string& text) {
-    *err_ << '\r' << text
-          << std::string(last_width_ > text.size() ? last_width_ - text.size() : 0, ' ')
-          << std::flush;
-    last_width_ = text.size();
-  }
-  void Clear() {
-    if (live_ && last_width_ > 0)
-      *err_ << '\r' << std::string(last_width_, ' ') << '\r' << std::flush;
-    last_width_ = 0;
-  }
-
-  std::ostream* err_;
-  bool live_ = false;
-  bool off_ = false;
-  int64_t last_shown_ns_ = 0;
-  size_t last_width_ = 0;
+  ProgressLine line_;
   std::map<int, std::pair<std::string, sim::RunProgress>> active_;
 };
 
@@ -402,187 +289,136 @@ std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice) {
   return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
 }
 
+const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags() {
+  using O = sim::ExperimentOptions;
+  using sim::CableAttachment;
+  using sim::RestLengthReference;
+  using Collisions = std::pair<bool, bool>;  // spine with the ground, spine with itself
+  static const std::vector<FieldFlag<O>> flags = {
+      // the motion (unset: sim::MotionFor(foot))
+      ChoiceFlag<O>("--pulled", LIFTOFF_FIELD(pulled_group),
+                    std::vector<std::pair<std::string, CableGroup>>{{"HR", CableGroup::kHR},
+                                                                    {"HL", CableGroup::kHL}},
+                    "Cable group the bend pulls (default: the foot's motion)"),
+      ChoiceFlag<O>("--rotation", LIFTOFF_FIELD(rotation),
+                    std::vector<std::pair<std::string, RotationSense>>{
+                        {"+", RotationSense::kPositive}, {"-", RotationSense::kNegative}},
+                    "Ramp direction, written --rotation=- (default: the foot's motion)"),
+      // the timeline
+      NumberFlag<O>("--bend-fraction", LIFTOFF_FIELD(bend_fraction), kSameUnit,
+                    "Bend each pulled cable to this fraction of its rest length"),
+      NumberFlag<O>("--bend-start-s", LIFTOFF_FIELD(bend_start_s), kSameUnit, "Bend start, s"),
+      NumberFlag<O>("--bend-speed", LIFTOFF_FIELD(bend_speed_m_per_s), kSameUnit,
+                    "Rest-length shortening speed, m/s"),
+      NumberFlag<O>("--ramp-deg", LIFTOFF_FIELD(ramp_angle_rad), kDegreesForRadians,
+                    "Final |rotation| of the ramp, degrees"),
+      NumberFlag<O>("--ramp-s", LIFTOFF_FIELD(ramp_duration_s), kSameUnit, "Ramp duration, s"),
+      NumberFlag<O>("--ramp-start-s", LIFTOFF_FIELD(ramp_start_s), kSameUnit, "Ramp start, s"),
+      NumberFlag<O>("--drop-height-m", LIFTOFF_FIELD(drop_height_m), kSameUnit,
+                    "Drop height above the standing pose, m"),
+      // the liftoff rule
+      NumberFlag<O>("--reference-s", LIFTOFF_FIELD(reference_time_s), kSameUnit,
+                    "Instant of the reference foot heights, s"),
+      NumberFlag<O>("--threshold-mm", LIFTOFF_FIELD(liftoff_threshold_m), kMillimetresForMetres,
+                    "Liftoff: height above the reference, mm"),
+      NumberFlag<O>("--sample-period-s", LIFTOFF_FIELD(sample_period_s), kSameUnit,
+                    "Sampling period, s"),
+      NumberFlag<O>("--ground-clearance-mm", LIFTOFF_FIELD(ground_clearance_m),
+                    kMillimetresForMetres,
+                    "Standing check: non-foot geometry this close to the ground rests on it, mm"),
+      NumberFlag<O>("--stop-after-rad", LIFTOFF_FIELD(stop_after_liftoff_rad), kSameUnit,
+                    "Stop once |rotation| is this far past the first liftoff, rad (inf: never)"),
+      // the model and the engine
+      NumberFlag<O>("--damping", LIFTOFF_FIELD(cable_damping_n_s_per_m), kSameUnit,
+                    "Cable damping, N*s/m"),
+      NumbersFlag<O>(
+          "--pretension-ratios", "pretension_ratios", 4,
+          [](const O& o) {
+            const sim::PretensionRatios& r = o.pretension_ratios;
+            return std::vector<double>{r.top_m, r.bottom_m, r.saddle_m, r.side_m};
+          },
+          [](O& o, const std::vector<double>& v) { o.pretension_ratios = {v[0], v[1], v[2], v[3]}; },
+          "four numbers TOP,BOTTOM,SADDLE,SIDE in m (T0 / k)",
+          "T0/k of HT,HB,saddles,sides, m"),
+      NumberFlag<O>("--friction", LIFTOFF_FIELD(friction), kSameUnit,
+                    "Ground friction coefficient (default: the model's)"),
+      NumberFlag<O>("--spine-friction", LIFTOFF_FIELD(spine_friction), kSameUnit,
+                    "Friction of the spine and hips with the ground (default: the model's)"),
+      NumberFlag<O>("--marker-height-m", LIFTOFF_FIELD(foot_marker_height_m), kSameUnit,
+                    "Foot markers this far above the feet's bottoms, m (default: the model's)"),
+      ChoiceFlag<O>("--attachment", LIFTOFF_FIELD(cable_attachment),
+                    std::vector<std::pair<std::string, CableAttachment>>{
+                        {"node", CableAttachment::kNode}, {"surface", CableAttachment::kSurface}},
+                    "Cable ends (default: the model's)"),
+      ChoiceFlag<O>("--rest-reference", LIFTOFF_FIELD(rest_length_reference),
+                    std::vector<std::pair<std::string, RestLengthReference>>{
+                        {"attachment", RestLengthReference::kAttachment},
+                        {"node", RestLengthReference::kNode}},
+                    "Rest length from the attachment or node distance (default: the model's)"),
+      ChoiceFlagOf<O, Collisions>(
+          "--collisions", "spine_ground_collisions",
+          {{"feet", {false, false}}, {"ground", {true, false}}, {"self", {false, true}},
+           {"all", {true, true}}},
+          [](const O& o) -> std::optional<Collisions> {
+            if (!o.spine_ground_collisions && !o.spine_self_collisions) return std::nullopt;
+            return Collisions{o.spine_ground_collisions.value_or(false),
+                              o.spine_self_collisions.value_or(false)};
+          },
+          [](O& o, const Collisions& c) {
+            o.spine_ground_collisions = c.first;
+            o.spine_self_collisions = c.second;
+          },
+          "What touches what: only the feet, the spine and hips with the ground too, the "
+          "spine rods with each other, or all (default: the model's)"),
+      ChoiceFlag<O>("--damping-cap", LIFTOFF_FIELD(damping_cap),
+                    std::vector<std::pair<std::string, bool>>{{"on", true}, {"off", false}},
+                    "Cap cable damping at the spring term (default: the model's)"),
+      NumberFlag<O>("--dt", LIFTOFF_FIELD(engine.time_step_s), kSameUnit, "Engine time step, s"),
+      SwitchFlag<O>("--implicit-stiffness", LIFTOFF_FIELD(engine.implicit_stiffness),
+                    "Treat cable stiffness implicitly too"),
+      NumberFlag<O>("--solver-iterations", LIFTOFF_FIELD(engine.solver_iterations), kSameUnit,
+                    "Contact solver sweeps per step"),
+      NumberFlag<O>("--contact-bias", LIFTOFF_FIELD(engine.contact_bias), kSameUnit,
+                    "Fraction of a penetration removed per step"),
+  };
+  return flags;
+}
+
+void AddExperimentFlags(CLI::App& app, SimExperimentChoice& choice) {
+  app.add_option("--model", choice.model_path,
+                 "Model JSON (default: the bundled samples/models/laika.json)");
+  AddFlags(app, ExperimentFlags(), choice.options);
+  app.add_option("--progress", choice.progress, "Progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+}
+
+const std::vector<FieldFlag<sim::MjcfOptions>>& MjcfFlags() {
+  using O = sim::MjcfOptions;
+  static const std::vector<FieldFlag<O>> flags = {
+      ChoiceFlag<O>("--hinge-drive", LIFTOFF_FIELD(hinge_drive),
+                    std::vector<std::pair<std::string, sim::MjcfHingeDrive>>{
+                        {"equality", sim::MjcfHingeDrive::kEquality},
+                        {"actuator", sim::MjcfHingeDrive::kPositionActuator}},
+                    "The hinge's drive: a constraint a runner sets each step, or a position "
+                    "servo"),
+      NumberFlag<O>("--lift-m", LIFTOFF_FIELD(lift_m), kSameUnit,
+                    "Raise the free bodies by this, m"),
+  };
+  return flags;
+}
+
 Result<sim::ExperimentOptions> ExperimentOptionsFrom(const SimExperimentChoice& choice) {
-  sim::ExperimentOptions options;
-  const NumberRange non_negative = {.min = 0.0};
-  const NumberRange hour = {.min = 0.0, .max = 3600.0};
-
-  // the motion
-  if (choice.pulled) {
-    const auto group = ParseCableGroup(*choice.pulled);
-    if (!group || (*group != CableGroup::kHR && *group != CableGroup::kHL)) {
-      return InvalidArgumentError("--pulled: expected HR or HL, got \"" + *choice.pulled + "\"");
-    }
-    options.pulled_group = *group;
-  }
-  if (choice.rotation) {
-    const auto sense = ParseRotationSense(*choice.rotation);
-    if (!sense) {
-      return InvalidArgumentError("--rotation: expected + or -, got \"" + *choice.rotation + "\"");
-    }
-    options.rotation = *sense;
-  }
-
-  // timeline and liftoff rule
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--bend-fraction", choice.bend_fraction,
-                                   {.min = 0.0, .max = 1.0, .min_exclusive = true}, "", 1.0,
-                                   options.bend_fraction));
-  LIFTOFF_RETURN_IF_ERROR(
-      TakeFlag("--bend-start-s", choice.bend_start_s, hour, "s", 1.0, options.bend_start_s));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--bend-speed", choice.bend_speed_m_per_s,
-                                   {.min = 0.0, .max = 10.0, .min_exclusive = true}, "m/s", 1.0,
-                                   options.bend_speed_m_per_s));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--ramp-deg", choice.ramp_deg, {.min = 0.0, .max = 180.0},
-                                   "degrees", 1.0 / kDegreesPerRadian, options.ramp_angle_rad));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--ramp-s", choice.ramp_s,
-                                   {.min = 0.0, .max = 3600.0, .min_exclusive = true}, "s", 1.0,
-                                   options.ramp_duration_s));
-  LIFTOFF_RETURN_IF_ERROR(
-      TakeFlag("--ramp-start-s", choice.ramp_start_s, hour, "s", 1.0, options.ramp_start_s));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--drop-height-m", choice.drop_height_m,
-                                   {.min = 0.0, .max = 0.5}, "m", 1.0, options.drop_height_m));
-  LIFTOFF_RETURN_IF_ERROR(
-      TakeFlag("--reference-s", choice.reference_s, hour, "s", 1.0, options.reference_time_s));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--threshold-mm", choice.threshold_mm,
-                                   {.min = 0.0, .max = 1000.0, .min_exclusive = true}, "mm", 1e-3,
-                                   options.liftoff_threshold_m));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--sample-period-s", choice.sample_period_s,
-                                   {.min = 0.0, .max = 10.0, .min_exclusive = true}, "s", 1.0,
-                                   options.sample_period_s));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--ground-clearance-mm", choice.ground_clearance_mm,
-                                   {.min = 0.0, .max = 1000.0}, "mm", 1e-3,
-                                   options.ground_clearance_m));
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--stop-after-rad", choice.stop_after_rad, non_negative, "rad",
-                                   1.0, options.stop_after_liftoff_rad));
-
-  // model choices
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--damping", choice.damping_n_s_per_m, non_negative, "N*s/m",
-                                   1.0, options.cable_damping_n_s_per_m));
-  if (!choice.pretension_ratios.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(
-        std::vector<double> ratios,
-        NumberList("--pretension-ratios", choice.pretension_ratios, 4,
-                   "TOP,BOTTOM,SADDLE,SIDE in m (T0 / k), e.g. 0.006,0.015,0.052,0.004"));
-    for (double ratio : ratios) {
-      if (!(ratio >= 0.0 && ratio < 1.0)) {
-        return InvalidArgumentError(
-            "--pretension-ratios: expected four numbers in [0, 1) m, got \"" +
-            choice.pretension_ratios + "\"");
-      }
-    }
-    options.pretension_ratios = {ratios[0], ratios[1], ratios[2], ratios[3]};
-  }
-  if (choice.friction) {
-    LIFTOFF_RETURN_IF_ERROR(CheckFlag("--friction", *choice.friction, non_negative, ""));
-    options.friction = *choice.friction;
-  }
-  if (choice.spine_friction) {
-    LIFTOFF_RETURN_IF_ERROR(
-        CheckFlag("--spine-friction", *choice.spine_friction, non_negative, ""));
-    options.spine_friction = *choice.spine_friction;
-  }
-  if (choice.marker_height_m) {
-    LIFTOFF_RETURN_IF_ERROR(
-        CheckFlag("--marker-height-m", *choice.marker_height_m, {.min = 0.0, .max = 100.0}, "m"));
-    options.foot_marker_height_m = *choice.marker_height_m;
-  }
-  if (!choice.attachment.empty()) {
-    if (choice.attachment == "node") {
-      options.cable_attachment = sim::CableAttachment::kNode;
-    } else if (choice.attachment == "surface") {
-      options.cable_attachment = sim::CableAttachment::kSurface;
-    } else {
-      return InvalidArgumentError("--attachment: expected node or surface, got \"" +
-                                  choice.attachment + "\"");
-    }
-  }
-  if (!choice.rest_reference.empty()) {
-    if (choice.rest_reference == "attachment") {
-      options.rest_length_reference = sim::RestLengthReference::kAttachment;
-    } else if (choice.rest_reference == "node") {
-      options.rest_length_reference = sim::RestLengthReference::kNode;
-    } else {
-      return InvalidArgumentError("--rest-reference: expected attachment or node, got \"" +
-                                  choice.rest_reference + "\"");
-    }
-  }
-  if (!choice.collisions.empty()) {
-    const std::string& mode = choice.collisions;
-    if (mode != "feet" && mode != "ground" && mode != "self" && mode != "all") {
-      return InvalidArgumentError("--collisions: expected feet, ground, self or all, got \"" +
-                                  mode + "\"");
-    }
-    options.spine_ground_collisions = mode == "ground" || mode == "all";
-    options.spine_self_collisions = mode == "self" || mode == "all";
-  }
-  if (!choice.damping_cap.empty()) {
-    if (choice.damping_cap != "on" && choice.damping_cap != "off") {
-      return InvalidArgumentError("--damping-cap: expected on or off, got \"" + choice.damping_cap +
-                                  "\"");
-    }
-    options.damping_cap = choice.damping_cap == "on";
-  }
-
-  // engine
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--dt", choice.dt_s, {.min = 1e-6, .max = 0.01}, "s", 1.0,
-                                   options.engine.time_step_s));
-  options.engine.implicit_stiffness = choice.implicit_stiffness;
-  if (choice.solver_iterations) {
-    LIFTOFF_RETURN_IF_ERROR(CheckFlag("--solver-iterations", *choice.solver_iterations,
-                                      {.min = 1.0, .max = 1000.0}, ""));
-    options.engine.solver_iterations = *choice.solver_iterations;
-  }
-  LIFTOFF_RETURN_IF_ERROR(TakeFlag("--contact-bias", choice.contact_bias, {.min = 0.0, .max = 1.0},
-                                   "", 1.0, options.engine.contact_bias));
-
-  // what only the whole set can say (a reference instant after the ramp's start, a sample
-  // period that is no multiple of the time step, ...)
-  const Status valid = options.Validate();
-  if (!valid.ok()) return RenameFields(valid);
-  return options;
+  const Status valid = choice.options.Validate();
+  if (valid.ok()) return choice.options;
+  const Status named = NameFlagIn(valid, ExperimentFlags());
+  return named.message() != valid.message() ? named : valid.WithContext("simulation options");
 }
 
 std::string DescribeOverrides(const SimExperimentChoice& choice) {
-  std::vector<std::string> parts;
-  auto number = [&](std::string_view flag, const std::optional<double>& value) {
-    if (value) parts.push_back(std::string(flag) + " " + FormatNumber(*value));
-  };
-  auto text = [&](std::string_view flag, const std::string& value) {
-    if (!value.empty()) parts.push_back(std::string(flag) + " " + value);
-  };
-  if (!choice.model_path.empty()) text("--model", choice.model_path.string());
-  if (choice.pulled) text("--pulled", *choice.pulled);
-  if (choice.rotation) parts.push_back("--rotation=" + *choice.rotation);
-  number("--bend-fraction", choice.bend_fraction);
-  number("--bend-start-s", choice.bend_start_s);
-  number("--bend-speed", choice.bend_speed_m_per_s);
-  number("--ramp-deg", choice.ramp_deg);
-  number("--ramp-s", choice.ramp_s);
-  number("--ramp-start-s", choice.ramp_start_s);
-  number("--drop-height-m", choice.drop_height_m);
-  number("--reference-s", choice.reference_s);
-  number("--threshold-mm", choice.threshold_mm);
-  number("--sample-period-s", choice.sample_period_s);
-  number("--ground-clearance-mm", choice.ground_clearance_mm);
-  number("--stop-after-rad", choice.stop_after_rad);
-  number("--damping", choice.damping_n_s_per_m);
-  text("--pretension-ratios", choice.pretension_ratios);
-  number("--friction", choice.friction);
-  number("--spine-friction", choice.spine_friction);
-  number("--marker-height-m", choice.marker_height_m);
-  text("--attachment", choice.attachment);
-  text("--rest-reference", choice.rest_reference);
-  text("--collisions", choice.collisions);
-  text("--damping-cap", choice.damping_cap);
-  number("--dt", choice.dt_s);
-  if (choice.implicit_stiffness) parts.push_back("--implicit-stiffness");
-  if (choice.solver_iterations) {
-    parts.push_back("--solver-iterations " + std::to_string(*choice.solver_iterations));
-  }
-  number("--contact-bias", choice.contact_bias);
-  std::string joined;
-  for (const std::string& part : parts) joined += (joined.empty() ? "" : " ") + part;
-  return joined;
+  const std::string model =
+      choice.model_path.empty() ? "" : "--model " + choice.model_path.string();
+  const std::string changed = DescribeChanged(ExperimentFlags(), choice.options);
+  return model + (!model.empty() && !changed.empty() ? " " : "") + changed;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -594,7 +430,7 @@ int RunSimRun(const SimRunCommand& command, std::ostream& out, std::ostream& err
   if (!options.ok()) return ReportError(options.status(), err);
   auto foot = FootFlag("--foot", command.foot);
   if (!foot.ok()) return ReportError(foot.status(), err);
-  auto tension = RunTensionPoint(command.tension, command.stiffness);
+  auto tension = RunTensionPoint(command.tension, command.stiffness_n_per_m);
   if (!tension.ok()) return ReportError(tension.status(), err);
   options->foot = *foot;
   options->tension_point = *tension;
@@ -670,8 +506,7 @@ stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string
     results.runs.push_back(std::move(entry));
   }
   if (!no_liftoff.empty()) {
-    std::string names;
-    for (const std::string& name : no_liftoff) names += (names.empty() ? "" : ", ") + name;
+    const std::string names = Join(no_liftoff, ", ");
     description += (description.empty() ? "" : "; ") +
                    std::string("stood but the targeted foot did not lift (left out): ") + names;
   }
@@ -692,7 +527,7 @@ Result<sim::SweepOptions> SweepOptionsFrom(const SimSweepCommand& command) {
                                             std::to_string(command.threads));
   }
   options.feet.clear();
-  for (const std::string& name : SplitCommas(command.feet)) {
+  for (const std::string& name : command.feet) {
     auto foot = FootFlag("--feet", name);
     if (!foot.ok()) return foot.status();
     if (std::find(options.feet.begin(), options.feet.end(), *foot) != options.feet.end()) {
@@ -700,9 +535,9 @@ Result<sim::SweepOptions> SweepOptionsFrom(const SimSweepCommand& command) {
     }
     options.feet.push_back(*foot);
   }
-  if (command.tensions != "all") {
+  if (command.tensions != std::vector<std::string>{"all"}) {
     options.tension_points.clear();
-    for (const std::string& name : SplitCommas(command.tensions)) {
+    for (const std::string& name : command.tensions) {
       auto point = sim::PaperTensionPointByName(name);
       if (!point.ok()) {
         return InvalidArgumentError("--tensions: expected all or a comma-separated "
@@ -740,11 +575,8 @@ Result<sim::SweepResult> RunSweepShowingProgress(const SimSweepCommand& command,
 }
 
 int RunSimSweep(const SimSweepCommand& command, std::ostream& out, std::ostream& err) {
-  const auto table_format = stats::ParseTableFormat(command.format);
-  if (!table_format) {
-    return ReportError(InvalidArgumentError("--format: expected md, csv, latex or json, got \"" +
-                                            command.format + "\""),
-                       err);
+  if (const auto checked = TableFormatFlag(command.format); !checked.ok()) {
+    return ReportError(checked.status(), err);
   }
   // the hardware trials are read before the sweep: a missing or broken manifest fails in
   // a second, not after the whole sweep
@@ -804,23 +636,13 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
   if (!options.ok()) return ReportError(options.status(), err);
   // MuJoCo's step: MjcfOptions' own unless --dt says otherwise; soft constraints never
   // faster than MuJoCo's floor of two steps
-  sim::MjcfOptions mjcf;
-  if (command.experiment.dt_s) mjcf.time_step_s = *command.experiment.dt_s;
+  sim::MjcfOptions mjcf = command.mjcf;
+  const double time_step_s = command.experiment.options.engine.time_step_s;
+  if (time_step_s != sim::ExperimentOptions().engine.time_step_s) mjcf.time_step_s = time_step_s;
   mjcf.contact_time_constant_s = std::max(mjcf.contact_time_constant_s, 2.0 * mjcf.time_step_s);
   mjcf.hinge_time_constant_s = std::max(mjcf.hinge_time_constant_s, 2.0 * mjcf.time_step_s);
-  mjcf.lift_m = command.lift_m;
-  if (command.hinge_drive == "equality") {
-    mjcf.hinge_drive = sim::MjcfHingeDrive::kEquality;
-  } else if (command.hinge_drive == "actuator") {
-    mjcf.hinge_drive = sim::MjcfHingeDrive::kPositionActuator;
-  } else {
-    return ReportError(InvalidArgumentError("--hinge-drive: expected equality or actuator, got \"" +
-                                            command.hinge_drive + "\""),
-                       err);
-  }
-  if (const Status checked = CheckFlag("--lift-m", command.lift_m, {.min = 0.0, .max = 1.0}, "m");
-      !checked.ok()) {
-    return ReportError(checked, err);
+  if (const Status valid = NameFlagIn(mjcf.Validate(), MjcfFlags()); !valid.ok()) {
+    return ReportError(valid, err);
   }
   if (command.output_path.empty()) {
     return ReportError(InvalidArgumentError("--output: expected a file name (or - for stdout)"),
@@ -872,6 +694,74 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
   if (!written.ok()) return ReportError(written, err);
   err << "wrote " << command.output_path.string() << " (" << model->Brief() << ")\n";
   return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------
+// the flags of the three
+
+Subcommand AddSimRunCommand(CLI::App& sim) {
+  auto command = std::make_shared<SimRunCommand>();
+  CLI::App* app = sim.add_subcommand(
+      "run", "One simulated test: each foot's liftoff rotation, optionally the height curves");
+  app->add_option("--foot", command->foot, "Foot the test targets: A, B, C or D")
+      ->capture_default_str();
+  app->add_option("--tension", command->tension,
+                  "Tension point: low, med-low, mean, med-high, high or 0..4")
+      ->capture_default_str();
+  app->add_option("--stiffness", command->stiffness_n_per_m,
+                  "Explicit stiffnesses SILICONE,BUNA_N,SPRING in N/m (instead of --tension)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  AddExperimentFlags(*app, command->experiment);
+  app->add_flag("--json", command->json, "JSON output");
+  app->add_option("--curves", command->curves_path,
+                  "Write the foot-height curves (CSV) here; - for stdout");
+  return RunsWith(app, command, RunSimRun);
+}
+
+Subcommand AddSimSweepCommand(CLI::App& sim) {
+  auto command = std::make_shared<SimSweepCommand>();
+  CLI::App* app = sim.add_subcommand(
+      "sweep",
+      "The tension points x the four foot motions in parallel (paper Table IV's sim columns)");
+  AddSweepFlags(*app, *command);
+  app->add_flag("--full-ramp", command->full_ramp,
+                "Run every test to the end of the ramp (same values, slower)");
+  AddExperimentFlags(*app, command->experiment);
+  app->add_option("--output,-o", command->output_path,
+                  "Write the simulation results JSON (for liftoff table --sim)");
+  app->add_flag("--json", command->json, "Print the results JSON instead of the table");
+  app->add_option("--hardware", command->hardware_path,
+                  "Trial manifest or 2018 Laika folder: also print the hardware-vs-simulation "
+                  "table");
+  app->add_option("--format,-f", command->format, "Hardware table format: md, csv, latex or json")
+      ->capture_default_str();
+  AddCalibrationFlag(*app, command->calibration);
+  AddLookupFlags(*app, command->lookup);
+  return RunsWith(app, command, RunSimSweep);
+}
+
+void AddSweepFlags(CLI::App& app, SimSweepCommand& command) {
+  AddListOption(app, "--feet", command.feet, "Simulated feet, comma-separated");
+  AddListOption(app, "--tensions", command.tensions,
+                "Simulated tension points, comma-separated names or 0..4, or all");
+  app.add_option("--threads", command.threads, "Sweep worker threads (0: all cores)")
+      ->capture_default_str();
+}
+
+Subcommand AddSimExportMjcfCommand(CLI::App& sim) {
+  auto command = std::make_shared<SimExportMjcfCommand>();
+  CLI::App* app = sim.add_subcommand("export-mjcf", "Write the model as a MuJoCo MJCF file");
+  app->add_option("--output,-o", command->output_path, "MJCF file; - for stdout")->required();
+  app->add_option("--foot", command->foot, "The experiment's model for this foot")
+      ->capture_default_str();
+  app->add_option("--tension", command->tension, "... at this tension point")
+      ->capture_default_str();
+  app->add_flag("--as-is", command->as_is,
+                "Export the model file as written (no tension point applied)");
+  AddFlags(*app, MjcfFlags(), command->mjcf);
+  AddExperimentFlags(*app, command->experiment);
+  return RunsWith(app, command, RunSimExportMjcf);
 }
 
 }  // namespace liftoff::cli

@@ -1,5 +1,6 @@
 #include "liftoff/cli/synth_commands.h"
 
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -143,6 +144,21 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
                                   : RunSet(command, *calibration, out, err);
+}
+
+Subcommand AddSynthCommand(CLI::App& parent) {
+  auto command = std::make_shared<SynthCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "synth",
+      "Render synthetic trials (video, controller log, ground truth) from a spec or a set");
+  app->add_option("spec", command->spec_path, "Trial spec JSON (see --print-spec)");
+  app->add_option("--set", command->set_name,
+                  "Write a whole named set: ci, paper, ci3d or hard3d (the 3D camera)");
+  app->add_option("--output,-o", command->output_dir, "Folder for the files");
+  app->add_flag("--print-spec", command->print_spec, "Print the default spec as JSON");
+  app->add_flag("--quiet,-q", command->quiet, "No progress lines on stderr");
+  AddCalibrationFlag(*app, command->calibration);
+  return RunsWith(app, command, RunSynth);
 }
 
 }  // namespace liftoff::cli

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <charconv>
 #include <iostream>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -18,13 +20,29 @@
 namespace liftoff::cli {
 namespace {
 
-// A number flag inside its range, else kInvalidArgument naming the flag.
-Status CheckNumberFlag(std::string_view flag, double value, const NumberRange& range,
-                       std::string_view unit) {
-  if (InNumberRange(value, range)) return Status::Ok();
-  return InvalidArgumentError(std::string(flag) + ": expected " + DescribeNumberRange(range) +
-                              (unit.empty() ? "" : " ") + std::string(unit) + ", got " +
-                              FormatNumber(value));
+// A region flag's "x,y,w,h" ("563,45,26,26"), px; kInvalidArgument naming the flag when
+// it is not four integers with x, y >= 0 and w, h > 0.
+Result<cv::Rect> RectFlag(std::string_view text, std::string_view flag) {
+  const auto fail = [&] {
+    return InvalidArgumentError(std::string(flag) + ": expected x,y,w,h in pixels (x, y >= 0; " +
+                                "w, h > 0), got \"" + std::string(text) + "\"");
+  };
+  int values[4] = {0, 0, 0, 0};
+  const char* at = text.data();
+  const char* end = text.data() + text.size();
+  for (int i = 0; i < 4; ++i) {
+    const auto [next, error] = std::from_chars(at, end, values[i]);
+    if (error != std::errc()) return fail();
+    at = next;
+    if (i < 3) {
+      if (at == end || *at != ',') return fail();
+      ++at;
+    }
+  }
+  if (at != end || values[0] < 0 || values[1] < 0 || values[2] <= 0 || values[3] <= 0) {
+    return fail();
+  }
+  return cv::Rect(values[0], values[1], values[2], values[3]);
 }
 
 // "FROM,TO" seconds
@@ -104,11 +122,11 @@ std::string FileStem(const std::string& id) {
 Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
   video::ClipAnalysisOptions options;
   if (!choice.led_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, video::ParseRect(choice.led_roi, "--led-roi"));
+    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, RectFlag(choice.led_roi, "--led-roi"));
   }
   if (!choice.foot_roi.empty()) {
     LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
-                             video::ParseRect(choice.foot_roi, "--foot-roi"));
+                             RectFlag(choice.foot_roi, "--foot-roi"));
   }
   if (!choice.foot.empty()) {
     const std::optional<Foot> foot = ParseFoot(choice.foot);
@@ -118,16 +136,16 @@ Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
     options.foot.tape_colour = *foot;
   }
   LIFTOFF_RETURN_IF_ERROR(
-      CheckNumberFlag("--px-per-mm", choice.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
-  LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-mm", choice.threshold_mm,
+      CheckFlagRange("--px-per-mm", choice.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
+  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--threshold-mm", choice.threshold_mm,
                                           {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
   if (choice.threshold_px) {
-    LIFTOFF_RETURN_IF_ERROR(CheckNumberFlag("--threshold-px", *choice.threshold_px,
+    LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--threshold-px", *choice.threshold_px,
                                             {.min = 0.0, .max = 1000.0, .min_exclusive = true},
                                             "px"));
   }
   LIFTOFF_RETURN_IF_ERROR(
-      CheckNumberFlag("--exposure-ms", choice.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
+      CheckFlagRange("--exposure-ms", choice.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
   options.foot.px_per_mm = choice.px_per_mm;
   options.foot.threshold_mm = choice.threshold_mm;
   options.foot.threshold_px = choice.threshold_px.value_or(0.0);
@@ -150,54 +168,31 @@ Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
 // progress
 
 Result<VideoProgress> VideoProgress::Create(std::string_view mode, std::ostream& err) {
-  if (mode != "auto" && mode != "live" && mode != "lines" && mode != "off") {
-    return InvalidArgumentError("--progress: expected auto, live, lines or off, got \"" +
-                                std::string(mode) + "\"");
-  }
-  const bool live = mode == "live" || (mode == "auto" && err.rdbuf() == std::cerr.rdbuf() &&
-                                       ::isatty(STDERR_FILENO) == 1);
-  return VideoProgress(err, live, mode == "off");
+  LIFTOFF_ASSIGN_OR_RETURN(ProgressLine line,
+                           ProgressLine::Create(mode, "--progress", "video", err));
+  return VideoProgress(std::move(line));
 }
 
-VideoProgress::VideoProgress(std::ostream& err, bool live, bool off)
-    : err_(&err),
-      live_(live),
-      off_(off),
-      started_ns_(MonotonicNowNs()),
-      last_shown_ns_(started_ns_) {}
+VideoProgress::VideoProgress(ProgressLine line)
+    : line_(std::move(line)), started_ns_(MonotonicNowNs()) {}
 
 void VideoProgress::Show(std::string_view label, int64_t frames_done, int64_t t_ns) {
-  if (off_) return;
+  if (line_.off()) return;
   // each clip's rate from its own start
   const int64_t now_ns = MonotonicNowNs();
   if (label != label_) {
     label_ = label;
     started_ns_ = now_ns;
   }
-  // live: at most 5 times a second; lines: every 5 s
-  const int64_t every_ns = live_ ? NsFromMilliseconds(200) : NsFromSeconds(5.0);
-  if (now_ns - last_shown_ns_ < every_ns) return;
-  last_shown_ns_ = now_ns;
+  if (!line_.Due()) return;
   const double wall_s = SecondsFromNs(now_ns - started_ns_);
-  const std::string text =
-      std::string(label) + ": frame " + std::to_string(frames_done) + ", " +
-      FormatSeconds(t_ns, 1) + " s of video, " +
-      FormatFixed(static_cast<double>(frames_done) / std::max(wall_s, 1e-3), 0) + " frames/s";
-  if (live_) {
-    *err_ << '\r' << text
-          << std::string(last_width_ > text.size() ? last_width_ - text.size() : 0, ' ')
-          << std::flush;
-    last_width_ = text.size();
-  } else {
-    *err_ << "video: " << text << std::endl;
-  }
+  line_.Show(std::string(label) + ": frame " + std::to_string(frames_done) + ", " +
+             FormatSeconds(t_ns, 1) + " s of video, " +
+             FormatFixed(static_cast<double>(frames_done) / std::max(wall_s, 1e-3), 0) +
+             " frames/s");
 }
 
-void VideoProgress::Done() {
-  if (live_ && last_width_ > 0)
-    *err_ << '\r' << std::string(last_width_, ' ') << '\r' << std::flush;
-  last_width_ = 0;
-}
+void VideoProgress::Done() { line_.Clear(); }
 
 Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::path& path,
                                                        const video::ClipAnalysisOptions& options,
@@ -286,6 +281,58 @@ Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
     err << "wrote " << written->Brief() << '\n';
   }
   return first_failure;
+}
+
+// ---------------------------------------------------------------------------------------
+// the flags
+
+std::vector<CLI::Option*> AddClipFlags(CLI::App& app, ClipChoice& clip) {
+  std::vector<CLI::Option*> options;
+  options.push_back(app.add_option("--led-roi", clip.led_roi,
+                                   "LED region x,y,w,h in pixels (default: located automatically)"));
+  options.push_back(app.add_option("--foot-roi", clip.foot_roi,
+                                   "Foot region x,y,w,h in pixels: the foot at rest and room "
+                                   "above it (without it: the LED only)"));
+  options.push_back(app.add_option(
+      "--foot", clip.foot, "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
+  options.push_back(app.add_option("--px-per-mm", clip.px_per_mm,
+                                   "Image scale at the foot, px per mm (0: from the foot's width)")
+                        ->capture_default_str());
+  CLI::Option* threshold_mm =
+      app.add_option("--threshold-mm", clip.threshold_mm, "Liftoff threshold above rest, mm")
+          ->capture_default_str();
+  options.push_back(threshold_mm);
+  options.push_back(app.add_option("--threshold-px", clip.threshold_px,
+                                   "Liftoff threshold above rest, px (> 0; instead of "
+                                   "--threshold-mm)")
+                        ->excludes(threshold_mm));
+  options.push_back(app.add_option("--exposure-ms", clip.exposure_ms,
+                                   "Camera exposure per frame, ms, at most the frame interval "
+                                   "(0: unknown; the LED then allows any exposure up to the "
+                                   "frame interval, the foot takes half the frame interval)")
+                        ->capture_default_str());
+  return options;
+}
+
+Subcommand AddVideoCommand(CLI::App& parent) {
+  auto command = std::make_shared<VideoCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "video", "Find the LED switch-on and the foot's liftoff in one clip, with proof");
+  app->add_option("clip", command->video_path, "Video file")->required();
+  AddClipFlags(*app, command->clip);
+  app->add_option("--rest-window", command->clip.rest_window,
+                  "Foot rest window FROM,TO in s from the LED switch-on (write "
+                  "--rest-window=-1,0)")
+      ->capture_default_str();
+  app->add_option("--liftoff", command->clip.liftoff, "Liftoff instant: threshold or onset")
+      ->capture_default_str();
+  app->add_option("--verify", command->verify_path, "Write a verification image (PNG)");
+  app->add_option("--annotate", command->annotate_path,
+                  "Write the clip with the detections drawn (Motion JPEG AVI)");
+  app->add_flag("--json", command->json, "JSON output");
+  app->add_option("--progress", command->progress, "Progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+  return RunsWith(app, command, RunVideo);
 }
 
 }  // namespace liftoff::cli

@@ -1,7 +1,6 @@
 #include "liftoff/video/clip_analysis.h"
 
 #include <algorithm>
-#include <charconv>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -518,29 +517,6 @@ cv::Rect RectFromRegion(const RegionPx& region) {
 
 RegionPx RegionFromRect(const cv::Rect& rect) {
   return {.x_px = rect.x, .y_px = rect.y, .width_px = rect.width, .height_px = rect.height};
-}
-
-Result<cv::Rect> ParseRect(std::string_view text, std::string_view what) {
-  const auto fail = [&] {
-    return InvalidArgumentError(std::string(what) + ": expected x,y,w,h in pixels (x, y >= 0; " +
-                                "w, h > 0), got \"" + std::string(text) + "\"");
-  };
-  int values[4] = {0, 0, 0, 0};
-  const char* at = text.data();
-  const char* end = text.data() + text.size();
-  for (int i = 0; i < 4; ++i) {
-    const auto [next, error] = std::from_chars(at, end, values[i]);
-    if (error != std::errc()) return fail();
-    at = next;
-    if (i < 3) {
-      if (at == end || *at != ',') return fail();
-      ++at;
-    }
-  }
-  if (at != end || values[0] < 0 || values[1] < 0 || values[2] <= 0 || values[3] <= 0) {
-    return fail();
-  }
-  return cv::Rect(values[0], values[1], values[2], values[3]);
 }
 
 }  // namespace liftoff::video

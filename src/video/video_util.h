@@ -14,10 +14,11 @@
 
 namespace liftoff::video::internal {
 
-// "600x400+80x90": position then size, as the headers' messages spell a region.
+// "80x90 at (600, 400)": size, then the top-left corner, as the messages spell a region
+// (X11's 80x90+600+400 would read the other way round; "600x400+80x90" did).
 inline std::string RectText(const cv::Rect& rect) {
-  return std::to_string(rect.x) + "x" + std::to_string(rect.y) + "+" + std::to_string(rect.width) +
-         "x" + std::to_string(rect.height);
+  return std::to_string(rect.width) + "x" + std::to_string(rect.height) + " at (" +
+         std::to_string(rect.x) + ", " + std::to_string(rect.y) + ")";
 }
 
 // The median of values[0, count) (reordered; the mean of the middle two for an even

@@ -39,7 +39,7 @@ ReportCommand SampleReport(const fs::path& dir) {
   ReportCommand command;
   command.manifest_path = SourceDir() / "samples" / "trials" / "manifest.json";
   command.output_dir = dir;
-  command.sweep.tensions = "mean,high";
+  command.sweep.tensions = {"mean", "high"};
   command.sweep.experiment.progress = "off";
   // a small calibration: seven tension scales, four Monte Carlo draws
   command.fit.sigma_min = 0.0;
@@ -234,8 +234,8 @@ TEST(CliReport, SampleCampaignTableFiguresAndPages) {
 
   // another experiment option is another cache entry
   ReportCommand other = SampleReport(dir);
-  other.sweep.experiment.threshold_mm = 2.0;
-  other.sweep.tensions = "high";
+  other.sweep.experiment.options.liftoff_threshold_m = 0.002;
+  other.sweep.tensions = {"high"};
   const CommandRun rerun = RunReportCommand(other);
   ASSERT_EQ(rerun.code, kExitOk) << rerun.err;
   EXPECT_THAT(rerun.out, HasSubstr("ran and cached in"));

@@ -160,7 +160,9 @@ TEST(SimCliRun, BadFlagsNameTheFlagWithTheirExitCode) {
     std::string message;
   };
   const std::vector<Case> cases = {
-      {"--threshold-mm 0", 3, "--threshold-mm: expected a number in (0, 1000] mm, got 0"},
+      {"--threshold-mm 0", 3,
+       "--threshold-mm: liftoff_threshold_m: expected a number in (0, 1], got 0"},
+      {"--ramp-s 0", 3, "--ramp-s: expected a number in (0, 3600], got 0"},
       {"--tension medium", 3, "--tension: expected low, med-low, mean, med-high, high"},
       {"--foot E", 3, "--foot: expected one of A, B, C, D, got \"E\""},
       {"--attachment glue", 3, "--attachment: expected node or surface"},
@@ -371,38 +373,49 @@ TEST(SimResultsFromSweep, RoundTripsThroughLoadSimResults) {
   EXPECT_EQ(loaded->ranges.at(Foot::kC).n_runs, 1);
 }
 
-TEST(ExperimentOptionsFrom, ConvertsUnitsAndKeepsDefaults) {
+TEST(ExperimentFlags, ConvertUnitsAndDescribeWhatDiffersFromTheDefaults) {
   SimExperimentChoice choice;
-  auto defaults = ExperimentOptionsFrom(choice);
-  ASSERT_TRUE(defaults.ok()) << defaults.status().ToString();
-  EXPECT_EQ(defaults->ramp_angle_rad, sim::ExperimentOptions().ramp_angle_rad);
-  EXPECT_FALSE(defaults->friction);
-  EXPECT_FALSE(defaults->cable_attachment);
+  CLI::App app;
+  AddExperimentFlags(app, choice);
   EXPECT_EQ(DescribeOverrides(choice), "");
-
-  choice.ramp_deg = 30.0;
-  choice.threshold_mm = 2.0;
-  choice.ground_clearance_mm = 0.5;
-  choice.friction = 0.25;
-  choice.collisions = "ground";
-  choice.attachment = "node";
-  choice.damping_cap = "off";
-  choice.pretension_ratios = "0.01,0.02,0.03,0.004";
-  auto options = ExperimentOptionsFrom(choice);
-  ASSERT_TRUE(options.ok()) << options.status().ToString();
-  EXPECT_NEAR(options->ramp_angle_rad, std::numbers::pi / 6.0, 1e-15);
-  EXPECT_NEAR(options->liftoff_threshold_m, 0.002, 1e-15);
-  EXPECT_NEAR(options->ground_clearance_m, 0.0005, 1e-15);
-  EXPECT_EQ(options->friction, 0.25);
-  EXPECT_EQ(options->spine_ground_collisions, true);
-  EXPECT_EQ(options->spine_self_collisions, false);
-  EXPECT_EQ(options->cable_attachment, sim::CableAttachment::kNode);
-  EXPECT_EQ(options->damping_cap, false);
-  EXPECT_EQ(options->pretension_ratios.saddle_m, 0.03);
+  app.parse(
+      "--ramp-deg 30 --threshold-mm 2 --ground-clearance-mm 0.5 --rotation=- --friction 0.25 "
+      "--attachment node --damping-cap off --pretension-ratios 0.01,0.02,0.03,0.004 "
+      "--collisions ground",
+      false);
+  const sim::ExperimentOptions& options = choice.options;
+  EXPECT_NEAR(options.ramp_angle_rad, std::numbers::pi / 6.0, 1e-15);
+  EXPECT_NEAR(options.liftoff_threshold_m, 0.002, 1e-15);
+  EXPECT_NEAR(options.ground_clearance_m, 0.0005, 1e-15);
+  EXPECT_EQ(options.rotation, RotationSense::kNegative);
+  EXPECT_EQ(options.friction, 0.25);
+  EXPECT_EQ(options.spine_ground_collisions, true);
+  EXPECT_EQ(options.spine_self_collisions, false);
+  EXPECT_EQ(options.cable_attachment, sim::CableAttachment::kNode);
+  EXPECT_EQ(options.damping_cap, false);
+  EXPECT_EQ(options.pretension_ratios.saddle_m, 0.03);
+  // untouched fields keep the struct's defaults
+  EXPECT_EQ(options.bend_fraction, sim::ExperimentOptions().bend_fraction);
+  EXPECT_FALSE(options.spine_friction);
+  ASSERT_TRUE(ExperimentOptionsFrom(choice).ok());
   EXPECT_EQ(DescribeOverrides(choice),
-            "--ramp-deg 30 --threshold-mm 2 --ground-clearance-mm 0.5 --pretension-ratios "
-            "0.01,0.02,0.03,0.004 --friction 0.25 --attachment node --collisions ground "
-            "--damping-cap off");
+            "--rotation=- --ramp-deg 30 --threshold-mm 2 --ground-clearance-mm 0.5 "
+            "--pretension-ratios 0.01,0.02,0.03,0.004 --friction 0.25 --attachment node "
+            "--collisions ground --damping-cap off");
+}
+
+TEST(ExperimentFlags, ValidateMessagesNameTheFlag) {
+  SimExperimentChoice choice;
+  choice.options.engine.solver_iterations = 0;
+  auto options = ExperimentOptionsFrom(choice);
+  ASSERT_FALSE(options.ok());
+  EXPECT_THAT(options.status().message(), ::testing::StartsWith("--solver-iterations: expected"));
+  choice = {};
+  choice.options.pretension_ratios.side_m = 2.0;
+  options = ExperimentOptionsFrom(choice);
+  ASSERT_FALSE(options.ok());
+  EXPECT_THAT(options.status().message(),
+              ::testing::StartsWith("--pretension-ratios: pretension_ratios.side_m: expected"));
 }
 
 }  // namespace

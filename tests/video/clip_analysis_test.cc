@@ -172,17 +172,6 @@ TEST(ClipAnalysisOptions, DefaultsAreValidAndBadValuesNameTheirField) {
   EXPECT_THAT(options.Validate().message(), HasSubstr("led: "));
 }
 
-TEST(ParseRect, ReadsFourIntegersAndNamesTheFlagOtherwise) {
-  auto rect = ParseRect("563,45,26,27", "--led-roi");
-  ASSERT_TRUE(rect.ok()) << rect.status().ToString();
-  EXPECT_EQ(*rect, cv::Rect(563, 45, 26, 27));
-  for (const char* bad : {"", "1,2,3", "1,2,3,4,5", "1,2,0,4", "-1,2,3,4", "a,b,c,d", "1,2,3,4 "}) {
-    auto parsed = ParseRect(bad, "--foot-roi");
-    EXPECT_EQ(parsed.status().code(), StatusCode::kInvalidArgument) << bad;
-    EXPECT_THAT(parsed.status().message(), HasSubstr("--foot-roi: expected x,y,w,h")) << bad;
-  }
-}
-
 TEST(LiftoffInstant, NamesRoundTrip) {
   for (const LiftoffInstant instant : {LiftoffInstant::kThreshold, LiftoffInstant::kOnset}) {
     EXPECT_EQ(ParseLiftoffInstant(LiftoffInstantName(instant)), instant);

@@ -404,12 +404,12 @@ TEST(FootTracker, RegionOutsideTheFrameIsInvalidArgument) {
   frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(90));
   const Status status = tracker.Process(frame);
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(status.message(), "foot ROI 600x400+80x90 is outside the 640x480 frame");
+  EXPECT_EQ(status.message(), "foot ROI 80x90 at (600, 400) is outside the 640x480 frame");
 
   options.foot_roi_px = cv::Rect(-5, 100, 40, 60);
   FootTracker left_of_it(options);
   EXPECT_EQ(left_of_it.Process(frame).message(),
-            "foot ROI -5x100+40x60 is outside the 640x480 frame");
+            "foot ROI 40x60 at (-5, 100) is outside the 640x480 frame");
 
 }
 

@@ -408,7 +408,7 @@ TEST(LedDetector, RoiOutsideTheFrameIsInvalidArgument) {
   LedDetector detector(WithRoi(cv::Rect(300, 200, 40, 60)));
   const Status status = detector.Process(frames[0]);
   EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(status.message(), "LED ROI 300x200+40x60 is outside the 320x240 frame");
+  EXPECT_EQ(status.message(), "LED ROI 40x60 at (300, 200) is outside the 320x240 frame");
 }
 
 TEST(LedDetector, FramesOutOfOrderOrOfAnotherSizeAreInvalidArgument) {
@@ -463,7 +463,8 @@ TEST(LedResult, BriefSaysWhenWhereAndHowMany) {
   result.pulses = {pulse};
   EXPECT_EQ(
       result.Brief(),
-      "LED on at 0.6167 s +- 4.2 ms (frame 37, 64 % lit), ROI 590x50+28x28 (located), 1 pulse");
+      "LED on at 0.6167 s +- 4.2 ms (frame 37, 64 % lit), ROI 28x28 at (590, 50) (located), "
+      "1 pulse");
 }
 
 // ---------------------------------------------------------------------------------------

@@ -1,6 +1,6 @@
 // The live-capture subcommands: `liftoff capture`, `liftoff emulate`, `liftoff ports` and
-// `liftoff journal`. Same shape as commands.h: apps/liftoff/main.cc maps flags onto these
-// option structs; each Run function writes results to `out`, diagnostics to `err`, and
+// `liftoff journal`. Same shape as commands.h: an Add function binds flags to each of
+// these option structs; each Run function writes results to `out`, diagnostics to `err`, and
 // returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
 
@@ -109,5 +109,11 @@ struct JournalCommand {
   int64_t max_records = 0;
 };
 int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& err);
+
+/// Each command above added to the command line `parent` (flags bound to its struct).
+Subcommand AddCaptureCommand(CLI::App& parent);
+Subcommand AddEmulateCommand(CLI::App& parent);
+Subcommand AddPortsCommand(CLI::App& parent);
+Subcommand AddJournalCommand(CLI::App& parent);
 
 }  // namespace liftoff::cli

@@ -1,5 +1,6 @@
-// The liftoff command line, one Run<Command>() per subcommand. apps/liftoff/main.cc only
-// maps flags onto these option structs (CLI11) and calls them; tests call them directly.
+// The liftoff command line, one Run<Command>() per subcommand, and one Add<Command>() that
+// binds its flags to its struct (CLI11, liftoff/cli/flags.h); command_table.cc lists
+// them. Tests call the Run functions directly.
 //
 // Every Run function writes results to `out`, diagnostics to `err`, and returns the
 // process exit code (ExitCodeFor; docs/cli.md). A failure never discards what was
@@ -12,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "liftoff/cli/flags.h"
 #include "liftoff/core/status.h"
 #include "liftoff/stats/sim_results.h"
 
@@ -154,5 +156,13 @@ struct CalibCommand {
   bool json = false;
 };
 int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err);
+
+/// Each command above added to the command line `parent`: its flags bound to a command
+/// struct of its own (defaults: the struct's), run by the returned Subcommand.
+Subcommand AddTableCommand(CLI::App& parent);
+Subcommand AddImport2018Command(CLI::App& parent);
+Subcommand AddSyncCommand(CLI::App& parent);
+Subcommand AddLogCommand(CLI::App& parent);
+Subcommand AddCalibCommand(CLI::App& parent);
 
 }  // namespace liftoff::cli

@@ -48,4 +48,7 @@ struct ReportCommand {
 /// still written).
 int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err);
 
+/// The command added to the command line `parent` (flags bound to its struct).
+Subcommand AddReportCommand(CLI::App& parent);
+
 }  // namespace liftoff::cli

@@ -1,7 +1,7 @@
 // `liftoff sim`: the simulated foot-lifting test (one run, with its height curves), the
 // tension sweep (the simulation columns of the paper's Table IV, as the results JSON the
-// table command reads), and the MJCF export. Same shape as commands.h: apps/liftoff/main.cc
-// maps flags onto these structs; each Run function writes results to `out`, progress and
+// table command reads), and the MJCF export. Same shape as commands.h: an Add function binds
+// flags to each struct; each Run function writes results to `out`, progress and
 // diagnostics to `err`, and returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
 
@@ -9,88 +9,47 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/flags.h"
 #include "liftoff/core/status.h"
 #include "liftoff/sim/experiment.h"
+#include "liftoff/sim/mjcf.h"
 #include "liftoff/sim/sweep.h"
 #include "liftoff/stats/sim_results.h"
 
 namespace liftoff::cli {
 
-/// The model and the experiment's overrides, shared by `sim run`, `sim sweep` and
-/// `sim export-mjcf`. Unset (nullopt / empty) fields keep ExperimentOptions' defaults (the
-/// paper's procedure) or the model file's settings. Units are those of the flag names.
+/// The model and the experiment's options, shared by `sim run`, `sim sweep` and
+/// `sim export-mjcf`. Each option is a field of sim::ExperimentOptions, bound to its flag
+/// by one line of ExperimentFlags(); unset optionals keep the model file's settings.
 struct SimExperimentChoice {
   /// Model file (docs/sim.md); empty: sim::DefaultModelPath(), the bundled Laika.
   std::filesystem::path model_path;
-
-  // the motion (default: sim::MotionFor(foot))
-  /// "HR" or "HL".
-  std::optional<std::string> pulled;
-  /// "+" or "-".
-  std::optional<std::string> rotation;
-
-  // the timeline
-  /// Bend: each pulled cable to this fraction of its rest length (0 < P <= 1).
-  std::optional<double> bend_fraction;
-  std::optional<double> bend_start_s;
-  /// Rest-length shortening speed, m/s.
-  std::optional<double> bend_speed_m_per_s;
-  /// Ramp: final |angle|, degrees (0 .. 180); duration and start, s.
-  std::optional<double> ramp_deg;
-  std::optional<double> ramp_s;
-  std::optional<double> ramp_start_s;
-  /// Drop height above the standing pose, m.
-  std::optional<double> drop_height_m;
-
-  // the liftoff rule
-  std::optional<double> reference_s;
-  std::optional<double> threshold_mm;
-  std::optional<double> sample_period_s;
-  std::optional<double> ground_clearance_mm;
-  /// Stop once the first foot lifted and |angle| went this far past it, rad.
-  std::optional<double> stop_after_rad;
-
-  // the model and the engine
-  /// Cable damping, N*s/m.
-  std::optional<double> damping_n_s_per_m;
-  /// "TOP,BOTTOM,SADDLE,SIDE": T0 / k of each group, m.
-  std::string pretension_ratios;
-  std::optional<double> friction;
-  /// Friction of non-foot geometry with the ground (with --collisions ground or all).
-  std::optional<double> spine_friction;
-  /// Foot markers this far above the feet's bottoms, m.
-  std::optional<double> marker_height_m;
-  /// "node" or "surface".
-  std::string attachment;
-  /// "attachment" or "node".
-  std::string rest_reference;
-  /// "feet" (only the feet touch anything), "ground" (spine and hips with the ground too),
-  /// "self" (spine rods with each other), "all"; empty: the model file's.
-  std::string collisions;
-  /// "on" or "off".
-  std::string damping_cap;
-  /// Engine time step, s.
-  std::optional<double> dt_s;
-  bool implicit_stiffness = false;
-  std::optional<int> solver_iterations;
-  std::optional<double> contact_bias;
-
+  /// The experiment as the flags set it (defaults: the paper's procedure); the foot and
+  /// the tension point are each command's own flags.
+  sim::ExperimentOptions options;
   /// Progress on stderr: "auto" (live on a terminal, else lines), "live", "lines", "off".
   std::string progress = "auto";
 };
 
-/// The experiment options the choice asks for (foot and tension point left at their
-/// defaults). kInvalidArgument naming the flag: "--threshold-mm: expected a number in
-/// (0, 1000], got 0".
+/// The experiment's flags, one per field of sim::ExperimentOptions (units those of the
+/// flag names: --ramp-deg sets ramp_angle_rad).
+const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags();
+
+/// Adds --model, ExperimentFlags() and --progress to `app`, bound to `choice`.
+void AddExperimentFlags(CLI::App& app, SimExperimentChoice& choice);
+
+/// The choice's experiment options once Validate() accepts them; kInvalidArgument naming
+/// the flag otherwise: "--ramp-s: expected a number in (0, 3600], got 0".
 Result<sim::ExperimentOptions> ExperimentOptionsFrom(const SimExperimentChoice& choice);
 
 /// The model file the choice names: its model_path, else sim::DefaultModelPath().
 std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice);
 
 /// The flags of `choice` that differ from the defaults, as a command line would give them
-/// ("--friction 0.25 --attachment node"); empty when none.
+/// ("--model m.json --friction 0.25 --attachment node"); empty when none.
 std::string DescribeOverrides(const SimExperimentChoice& choice);
 
 /// `liftoff sim run`: one experiment.
@@ -100,8 +59,9 @@ struct SimRunCommand {
   std::string foot = "A";
   /// Tension point: a name ("low", "med-low", "mean", "med-high", "high") or "0".."4".
   std::string tension = "high";
-  /// Explicit stiffnesses "SILICONE,BUNA_N,SPRING", N/m (wins over `tension`).
-  std::string stiffness;
+  /// Explicit stiffnesses SILICONE, BUNA_N, SPRING, N/m (wins over `tension`); empty:
+  /// the tension point's.
+  std::vector<double> stiffness_n_per_m;
   /// The outcome as JSON ("liftoff-sim-run", docs/sim.md) instead of text.
   bool json = false;
   /// Write the foot-height curves (CSV, sim::HeightCurvesCsv) here; "-": to `out`
@@ -113,10 +73,10 @@ int RunSimRun(const SimRunCommand& command, std::ostream& out, std::ostream& err
 /// `liftoff sim sweep`: the tension points x the feet, in parallel.
 struct SimSweepCommand {
   SimExperimentChoice experiment;
-  /// Feet, comma-separated ("A,B,C,D").
-  std::string feet = "A,B,C,D";
-  /// Tension points, comma-separated names or indices, or "all".
-  std::string tensions = "all";
+  /// Feet ("A".."D").
+  std::vector<std::string> feet = {"A", "B", "C", "D"};
+  /// Tension points: names or indices, or {"all"}.
+  std::vector<std::string> tensions = {"all"};
   /// Worker threads; 0: all cores.
   int threads = 0;
   /// Run every experiment to the end of the ramp (default: stop once the targeted foot's
@@ -154,14 +114,14 @@ struct SimExportMjcfCommand {
   std::string tension = "high";
   /// Export the model file exactly as written (its own stiffnesses and pretensions).
   bool as_is = false;
-  /// "equality" (a constraint a runner sets each step) or "actuator" (a position servo,
-  /// for MuJoCo's simulate slider).
-  std::string hinge_drive = "equality";
-  /// Free bodies raised by this much, m (the drop height makes the file start the drop).
-  double lift_m = 0.0;
+  /// The file's options as the flags set them (MjcfFlags()); its time step and time
+  /// constants are replaced as said above.
+  sim::MjcfOptions mjcf;
   /// Output file; "-": `out`.
   std::filesystem::path output_path;
 };
+/// The export's flags (--hinge-drive, --lift-m), one per field of sim::MjcfOptions.
+const std::vector<FieldFlag<sim::MjcfOptions>>& MjcfFlags();
 int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std::ostream& err);
 
 /// The sweep as simulation results (what the table command reads): one run per sweep run,
@@ -170,5 +130,13 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
 /// foot never lifted has no value the format can hold (a standing run needs liftoff_rad):
 /// it is left out and named in the description. `description` starts the description.
 stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string description);
+
+/// The three subcommands of `liftoff sim`, added to the `sim` command: flags bound to
+/// their command structs.
+Subcommand AddSimRunCommand(CLI::App& sim);
+Subcommand AddSimSweepCommand(CLI::App& sim);
+Subcommand AddSimExportMjcfCommand(CLI::App& sim);
+/// --feet, --tensions and --threads of the sweep (`sim sweep`, `report`).
+void AddSweepFlags(CLI::App& app, SimSweepCommand& command);
 
 }  // namespace liftoff::cli

@@ -1,5 +1,5 @@
 // `liftoff synth`: synthetic trials (video, controller log, ground truth) from a spec,
-// or a whole named set. Same shape as commands.h: apps/liftoff/main.cc maps flags onto
+// or a whole named set. Same shape as commands.h: AddSynthCommand binds flags to
 // SynthCommand; RunSynth writes results to `out`, progress and diagnostics to `err`, and
 // returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
@@ -30,5 +30,8 @@ struct SynthCommand {
   CalibrationChoice calibration;
 };
 int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err);
+
+/// The command added to the command line `parent` (flags bound to its struct).
+Subcommand AddSynthCommand(CLI::App& parent);
 
 }  // namespace liftoff::cli

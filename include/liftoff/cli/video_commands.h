@@ -1,7 +1,7 @@
 // `liftoff video`: one clip's LED switch-on and foot liftoff, with proof (verification
 // image, annotated video); and the video parts of `liftoff table` (progress while trials'
 // videos are analysed, a verification image per analysed trial). Same shape as
-// commands.h: apps/liftoff/main.cc maps flags onto these structs; each Run function
+// commands.h: an Add function binds flags to each struct; each Run function
 // writes results to `out`, progress and diagnostics to `err`, and returns the process
 // exit code (ExitCodeFor; docs/cli.md).
 #pragma once
@@ -14,6 +14,7 @@
 #include <string_view>
 
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/progress_line.h"
 #include "liftoff/core/status.h"
 #include "liftoff/sync/trial_analysis.h"
 #include "liftoff/video/clip_analysis.h"
@@ -38,9 +39,7 @@ int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err);
 /// The flags of a clip analysis as its options; kInvalidArgument naming the flag.
 Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice);
 
-/// A progress line on `err` for long video analyses: rewritten in place ("live"), one line
-/// every 5 s of wall time ("lines"), or nothing ("off"); "auto" is live when `err` is the
-/// process' standard error and a terminal, else lines.
+/// The progress of long video analyses on a ProgressLine: frames, video time and rate.
 class VideoProgress {
  public:
   /// kInvalidArgument "--progress: expected auto, live, lines or off, got ..." for another
@@ -52,14 +51,10 @@ class VideoProgress {
   void Done();
 
  private:
-  VideoProgress(std::ostream& err, bool live, bool off);
-  std::ostream* err_;
-  bool live_ = false;
-  bool off_ = false;
+  explicit VideoProgress(ProgressLine line);
+  ProgressLine line_;
   std::string label_;
   int64_t started_ns_ = 0;
-  int64_t last_shown_ns_ = 0;
-  size_t last_width_ = 0;
 };
 
 /// AnalyzeClip showing its progress on `progress` (labelled with the clip's file name);
@@ -78,5 +73,8 @@ std::filesystem::path TrialVerificationPath(const std::filesystem::path& dir,
 /// on `err`. Returns the first error; the other images are still written.
 Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
                                const std::filesystem::path& dir, std::ostream& err);
+
+/// The command added to the command line `parent` (flags bound to its struct).
+Subcommand AddVideoCommand(CLI::App& parent);
 
 }  // namespace liftoff::cli

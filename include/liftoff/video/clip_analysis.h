@@ -135,8 +135,5 @@ Result<ClipAnalysis> AnalyzeClip(const std::filesystem::path& path,
 /// A manifest region as an OpenCV rectangle, and back.
 cv::Rect RectFromRegion(const RegionPx& region);
 RegionPx RegionFromRect(const cv::Rect& rect);
-/// A rectangle from a flag's "x,y,w,h" ("563,45,26,26"), px. kInvalidArgument naming `what`
-/// when it is not four integers with x, y >= 0 and w, h > 0.
-Result<cv::Rect> ParseRect(std::string_view text, std::string_view what);
 
 }  // namespace liftoff::video

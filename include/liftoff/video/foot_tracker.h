@@ -180,7 +180,7 @@ class FootTracker {
   ~FootTracker();
 
   /// Feeds the next frame. kInvalidArgument when the foot region is not inside the frame
-  /// ("foot ROI 600x400+80x90 is outside the 640x480 frame"), when the options do not
+  /// ("foot ROI 80x90 at (600, 400) is outside the 640x480 frame"), when the options do not
   /// validate, when the picture is not BGR 8-bit or changes size, or when t_ns does not
   /// increase. The first 4 frames make the templates; every frame after registers the
   /// patches (bench/video_bench prints the cost).

@@ -100,7 +100,8 @@ struct LedResult {
   /// For people: "LED dim: on-off contrast 9 grey levels (expected >= 20)", "LED already
   /// on in the first frame: the first switch-on may have been missed", ...
   std::vector<std::string> warnings;
-  /// "LED on at 0.6167 s +- 4.2 ms (frame 37, 64 % lit), ROI 590x50+28x28 (located), 1 pulse".
+  /// "LED on at 0.6167 s +- 4.2 ms (frame 37, 64 % lit), ROI 28x28 at (590, 50) (located),
+  /// 1 pulse".
   std::string Brief() const;
 };
 
@@ -138,7 +139,7 @@ class LedDetector {
   ~LedDetector();
 
   /// Feeds the next frame (decode order, increasing t_ns). kInvalidArgument when a given
-  /// ROI is not inside the frame ("LED ROI 700x20+40x40 is outside the 640x480 frame").
+  /// ROI is not inside the frame ("LED ROI 40x40 at (700, 20) is outside the 640x480 frame").
   Status Process(const Frame& frame);
   /// The parts of a `frame_px` frame that Process reads: with an ROI, the rows it spans
   /// (and the frame beside it, for the lighting) and the bands of reference cells; without

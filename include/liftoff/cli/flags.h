@@ -1,0 +1,296 @@
+// Command-line flags bound once to the fields of option structs (COLMAP's OptionManager
+// is the model). A table of FieldFlag lines, one per field, is the only place a flag is
+// named: it adds the flag to a CLI11 command bound to the field (its help shows the
+// field's value at that moment, i.e. the struct's default), writes the field back as the
+// flag would be given (DescribeChanged), and names the flag in the struct's Validate()
+// messages (NameFlagIn). Validate() stays the only range check.
+//
+//   using O = sim::ExperimentOptions;
+//   NumberFlag<O>("--threshold-mm", LIFTOFF_FIELD(liftoff_threshold_m), kMillimetresForMetres,
+//                 "Liftoff: height above the reference, mm"),
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "liftoff/cli/cli11.h"
+
+#include "liftoff/core/json.h"
+#include "liftoff/core/status.h"
+
+namespace liftoff::cli {
+
+/// A bad value for a flag that no option struct can hold (a word outside the flag's
+/// choices, a list of the wrong length), thrown while parsing: RunCommandLine reports its
+/// status like a Run function's failure (the class's exit code, docs/cli.md).
+class FlagError : public CLI::ParseError {
+ public:
+  explicit FlagError(Status status);
+  const Status& status() const { return status_; }
+
+ private:
+  Status status_;
+};
+
+/// `parts` with `separator` between them: Join({"A", "C"}, ",") is "A,C".
+std::string Join(const std::vector<std::string>& parts, std::string_view separator);
+
+/// "a or b", "a, b or c": the words a flag takes, for messages and help.
+std::string OneOf(const std::vector<std::string>& words);
+
+/// Units of a flag per unit of its field: the flag reads field * flag_per_field.
+struct FlagUnit {
+  double flag_per_field = 1.0;
+};
+inline constexpr FlagUnit kSameUnit{1.0};
+inline constexpr FlagUnit kMillimetresForMetres{1e3};
+inline constexpr FlagUnit kDegreesForRadians{180.0 / std::numbers::pi};
+
+/// One flag bound to one field of `Options`.
+template <typename Options>
+struct FieldFlag {
+  /// "--ramp-deg".
+  std::string flag;
+  /// The field's name as Validate() writes it ("ramp_angle_rad", "engine.time_step_s").
+  std::string field;
+  /// Whether the flag's unit differs from the field's.
+  bool scaled = false;
+  /// A flag without a value (given: on).
+  bool is_switch = false;
+  /// Adds the flag to `app`, bound to the field of `options` (which must outlive `app`).
+  std::function<CLI::Option*(CLI::App& app, Options& options)> add;
+  /// The field's value as the flag writes it; empty when unset (an empty optional).
+  std::function<std::string(const Options& options)> text;
+};
+
+/// The field's name and an accessor for it, for the Flag factories below:
+/// LIFTOFF_FIELD(engine.time_step_s).
+#define LIFTOFF_FIELD(path) #path, [](auto& options) -> auto& { return options.path; }
+
+namespace flags_internal {
+template <typename T>
+struct Unwrap {
+  using type = T;
+};
+template <typename T>
+struct Unwrap<std::optional<T>> {
+  using type = T;
+};
+template <typename Options, typename Access>
+using FieldType = std::remove_cvref_t<decltype(std::declval<Access>()(std::declval<Options&>()))>;
+}  // namespace flags_internal
+
+/// A number flag (double or int field, optional or not) in `unit` (a double field).
+template <typename Options, typename Access>
+FieldFlag<Options> NumberFlag(std::string flag, std::string field, Access access, FlagUnit unit,
+                              std::string help) {
+  using Field = flags_internal::FieldType<Options, Access>;
+  using Value = typename flags_internal::Unwrap<Field>::type;
+  FieldFlag<Options> bound{flag, std::move(field), unit.flag_per_field != 1.0, false, {}, {}};
+  bound.text = [access, unit](const Options& options) -> std::string {
+    const Field& value = access(options);
+    if constexpr (!std::is_same_v<Field, Value>) {
+      if (!value) return "";
+      if constexpr (std::is_integral_v<Value>) return std::to_string(*value);
+      else return FormatNumber(*value * unit.flag_per_field);
+    } else if constexpr (std::is_integral_v<Value>) {
+      return std::to_string(value);
+    } else {
+      return FormatNumber(value * unit.flag_per_field);
+    }
+  };
+  bound.add = [flag, help, access, unit, text = bound.text](CLI::App& app, Options& options) {
+    Field& target = access(options);
+    CLI::Option* option = app.add_option_function<Value>(
+        flag,
+        [&target, unit](const Value& value) {
+          if constexpr (std::is_integral_v<Value>) {
+            target = value;
+          } else {
+            target = value / unit.flag_per_field;
+          }
+        },
+        help);
+    return option->default_function([&options, text] { return text(options); })
+        ->capture_default_str();
+  };
+  return bound;
+}
+
+/// A flag taking one of `words`, each standing for a value; `get` reads the field (nullopt:
+/// unset), `set` writes it. Any other word: FlagError "--flag: expected a or b, got "c"".
+template <typename Options, typename Value>
+FieldFlag<Options> ChoiceFlagOf(std::string flag, std::string field,
+                                std::vector<std::pair<std::string, Value>> words,
+                                std::function<std::optional<Value>(const Options&)> get,
+                                std::function<void(Options&, const Value&)> set,
+                                std::string help) {
+  std::vector<std::string> names;
+  for (const auto& word : words) names.push_back(word.first);
+  FieldFlag<Options> bound{flag, std::move(field), false, false, {}, {}};
+  bound.text = [words, get](const Options& options) -> std::string {
+    const std::optional<Value> value = get(options);
+    if (!value) return "";
+    for (const auto& [name, meaning] : words) {
+      if (meaning == *value) return name;
+    }
+    return "";
+  };
+  bound.add = [flag, help, words, names, set, text = bound.text](CLI::App& app,
+                                                                 Options& options) {
+    CLI::Option* option = app.add_option_function<std::string>(
+        flag,
+        [flag, words, names, set, &options](const std::string& given) {
+          for (const auto& [name, meaning] : words) {
+            if (name == given) return set(options, meaning);
+          }
+          throw FlagError(InvalidArgumentError(flag + ": expected " + OneOf(names) + ", got \"" +
+                                               given + "\""));
+        },
+        help);
+    return option->type_name(Join(names, "|"))
+        ->default_function([&options, text] { return text(options); })
+        ->capture_default_str();
+  };
+  return bound;
+}
+
+/// ChoiceFlagOf for a plain or optional field.
+template <typename Options, typename Access, typename Value>
+FieldFlag<Options> ChoiceFlag(std::string flag, std::string field, Access access,
+                              std::vector<std::pair<std::string, Value>> words,
+                              std::string help) {
+  return ChoiceFlagOf<Options, Value>(
+      std::move(flag), std::move(field), std::move(words),
+      [access](const Options& options) -> std::optional<Value> { return access(options); },
+      [access](Options& options, const Value& value) { access(options) = value; },
+      std::move(help));
+}
+
+/// A flag without a value for a bool field: given means true.
+template <typename Options, typename Access>
+FieldFlag<Options> SwitchFlag(std::string flag, std::string field, Access access,
+                              std::string help) {
+  FieldFlag<Options> bound{flag, std::move(field), false, true, {}, {}};
+  bound.text = [access](const Options& options) -> std::string {
+    return access(options) ? "true" : "";
+  };
+  bound.add = [flag, help, access](CLI::App& app, Options& options) {
+    return app.add_flag(flag, access(options), help);
+  };
+  return bound;
+}
+
+/// A flag taking `count` comma-separated numbers ("1,2,3"); `get` reads them from the
+/// struct, `set` writes them. Another count: FlagError naming the flag and `expected`.
+template <typename Options>
+FieldFlag<Options> NumbersFlag(std::string flag, std::string field, size_t count,
+                               std::function<std::vector<double>(const Options&)> get,
+                               std::function<void(Options&, const std::vector<double>&)> set,
+                               std::string expected, std::string help) {
+  FieldFlag<Options> bound{flag, std::move(field), false, false, {}, {}};
+  bound.text = [get](const Options& options) {
+    std::string joined;
+    for (double value : get(options)) joined += (joined.empty() ? "" : ",") + FormatNumber(value);
+    return joined;
+  };
+  bound.add = [flag, count, set, expected, help, text = bound.text](CLI::App& app,
+                                                                    Options& options) {
+    CLI::Option* option = app.add_option_function<std::vector<double>>(
+        flag,
+        [flag, count, set, expected, &options](const std::vector<double>& values) {
+          if (values.size() != count) {
+            throw FlagError(InvalidArgumentError(flag + ": expected " + expected + ", got " +
+                                                 std::to_string(values.size()) + " numbers"));
+          }
+          set(options, values);
+        },
+        help);
+    return option->delimiter(',')
+        ->allow_extra_args(false)
+        ->default_function([&options, text] { return text(options); })
+        ->capture_default_str();
+  };
+  return bound;
+}
+
+/// Adds every flag of `flags` to `app`, bound to `options` (which must outlive `app`).
+template <typename Options>
+void AddFlags(CLI::App& app, const std::vector<FieldFlag<Options>>& flags, Options& options) {
+  for (const FieldFlag<Options>& flag : flags) flag.add(app, options);
+}
+
+/// The flags whose field in `options` differs from a default-constructed Options, as a
+/// command line would give them ("--friction 0.25 --rotation=-"); empty when none.
+template <typename Options>
+std::string DescribeChanged(const std::vector<FieldFlag<Options>>& flags,
+                            const Options& options) {
+  const Options defaults;
+  std::string joined;
+  for (const FieldFlag<Options>& flag : flags) {
+    const std::string value = flag.text(options);
+    if (value == flag.text(defaults)) continue;
+    std::string given = flag.flag;
+    if (!flag.is_switch) given += (!value.empty() && value.front() == '-' ? "=" : " ") + value;
+    joined += (joined.empty() ? "" : " ") + given;
+  }
+  return joined;
+}
+
+/// `message` of a Validate() failure about field `field` rewritten to name `flag`: the
+/// field's name replaced by the flag's ("--dt: expected ..."), or, when the flag's unit is
+/// not the field's, put in front ("--ramp-deg: ramp_angle_rad: expected ..."); nullopt
+/// when the message is not about `field` (it starts with "field:" or "field.", a nested
+/// field's context written "outer: inner:" also matching "outer.inner").
+std::optional<std::string> MessageNamingFlag(const std::string& message, const std::string& flag,
+                                             const std::string& field, bool scaled);
+
+/// `status` from Options' Validate() with the flag of the field it names in front; other
+/// statuses as they are.
+template <typename Options>
+Status NameFlagIn(const Status& status, const std::vector<FieldFlag<Options>>& flags) {
+  if (status.ok()) return status;
+  for (const FieldFlag<Options>& flag : flags) {
+    if (auto message = MessageNamingFlag(status.message(), flag.flag, flag.field, flag.scaled)) {
+      return Status(status.code(), *message);
+    }
+  }
+  return status;
+}
+
+/// A comma-separated list flag ("--feet A,C") bound to `field`; its help shows the
+/// field's value.
+CLI::Option* AddListOption(CLI::App& app, const std::string& flag, std::vector<std::string>& field,
+                           const std::string& help);
+
+/// A subcommand on the command line: its CLI11 command (flags bound to its command struct)
+/// and the function that runs that struct once parsed.
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int(std::ostream& out, std::ostream& err)> run;
+};
+
+/// The Subcommand that runs `run` with `command` (the struct `app`'s flags are bound to).
+template <typename Command>
+Subcommand RunsWith(CLI::App* app, std::shared_ptr<Command> command,
+                    int (*run)(const Command&, std::ostream&, std::ostream&)) {
+  return {app, [command = std::move(command), run](std::ostream& out, std::ostream& err) {
+            return run(*command, out, err);
+          }};
+}
+
+/// Parses `argv` with `app` and runs the subcommand chosen among `commands`. Exit codes:
+/// the Run function's; usage errors kExitUsage; a FlagError its status' class; an
+/// exception kExitInternal (docs/cli.md).
+int RunCommandLine(CLI::App& app, const std::vector<Subcommand>& commands, int argc,
+                   const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace liftoff::cli

@@ -1,0 +1,135 @@
+// `liftoff log`: what a controller log holds; its conversion.
+#include "liftoff/cli/commands.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
+#include "liftoff/core/time.h"
+#include "liftoff/sync/trial_analysis.h"
+
+namespace liftoff::cli {
+// ---------------------------------------------------------------------------------------
+// liftoff log
+
+int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
+  const Status gap_checked = CheckFlagRange("--gap-threshold", command.gap_threshold_s,
+                                            sync::LookupOptions::kGapThresholdRange, "s");
+  if (!gap_checked.ok()) return ReportError(gap_checked, err);
+  const Status bad_lines_checked = CheckMaxBadLinesFlag(command.max_bad_lines);
+  if (!bad_lines_checked.ok()) return ReportError(bad_lines_checked, err);
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (const int refused = RefuseToOverwriteInputs(
+          {{"--convert", command.convert_path}},
+          {{"LOG", command.log_path}, {"calibration", calibration->source_path}}, err);
+      refused != kExitOk) {
+    return refused;
+  }
+  LogReadOptions read_options;
+  read_options.max_bad_lines = command.max_bad_lines;
+  auto log = LoadLogByName(command.log_path, command.log_format, *calibration, read_options);
+  if (!log.ok()) return ReportError(log.status(), err);
+  PrintLogWarnings(log->report, err);
+
+  // span, rate and gaps of the sample stream
+  const std::vector<LogSample>& samples = log->samples;
+  const int64_t gap_threshold_ns = NsFromSeconds(command.gap_threshold_s);
+  int64_t gaps = 0;
+  int64_t longest_gap_ns = 0;
+  int64_t longest_gap_at_ns = 0;
+  for (size_t i = 1; i < samples.size(); ++i) {
+    const int64_t step = samples[i].device_time_ns - samples[i - 1].device_time_ns;
+    if (step > gap_threshold_ns) ++gaps;
+    if (step > longest_gap_ns) {
+      longest_gap_ns = step;
+      longest_gap_at_ns = samples[i - 1].device_time_ns;
+    }
+  }
+  const int64_t span_ns = log->LastSampleNs() - log->FirstSampleNs();
+  const double rate_hz =
+      span_ns > 0 ? static_cast<double>(samples.size() - 1) / SecondsFromNs(span_ns) : 0.0;
+  const std::optional<int64_t> led_ns = log->LedOnTimeNs();
+  double min_angle = INFINITY, max_angle = -INFINITY;
+  for (const LogSample& sample : samples) {
+    if (std::isnan(sample.vertebra_rad)) continue;
+    min_angle = std::min(min_angle, sample.vertebra_rad);
+    max_angle = std::max(max_angle, sample.vertebra_rad);
+  }
+
+  if (command.json) {
+    nlohmann::json document = {
+        {"log", command.log_path.string()},
+        {"format", log->report.format},
+        {"calibration", log->header.calibration},
+        {"samples", samples.size()},
+        {"events", log->events.size()},
+        {"first_sample_s", SecondsFromNs(log->FirstSampleNs())},
+        {"last_sample_s", SecondsFromNs(log->LastSampleNs())},
+        {"mean_rate_hz", rate_hz},
+        {"gaps", gaps},
+        {"gap_threshold_s", command.gap_threshold_s},
+        {"longest_gap_s", SecondsFromNs(longest_gap_ns)},
+        {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
+        {"vertebra_min_rad",
+         std::isfinite(min_angle) ? nlohmann::json(min_angle) : nlohmann::json()},
+        {"vertebra_max_rad",
+         std::isfinite(max_angle) ? nlohmann::json(max_angle) : nlohmann::json()},
+        {"bad_lines", log->report.bad_lines},
+        {"truncated_last_line", log->report.truncated_last_line},
+    };
+    out << document.dump(2) << '\n';
+  } else {
+    out << command.log_path.string() << " (" << log->report.format << ")\n"
+        << "  samples: " << samples.size() << ", events: " << log->events.size()
+        << ", bad lines: " << log->report.bad_lines
+        << (log->report.truncated_last_line ? " (last line truncated)" : "") << '\n'
+        << "  device time: " << FormatSeconds(log->FirstSampleNs()) << " .. "
+        << FormatSeconds(log->LastSampleNs()) << " s, mean rate " << FormatFixed(rate_hz, 1)
+        << " Hz\n"
+        << "  gaps longer than " << FormatFixed(command.gap_threshold_s, 3) << " s: " << gaps;
+    if (longest_gap_ns > 0) {
+      out << " (longest " << FormatSeconds(longest_gap_ns) << " s after "
+          << FormatSeconds(longest_gap_at_ns) << " s)";
+    }
+    out << '\n'
+        << "  LED on: "
+        << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)") << '\n';
+    if (std::isfinite(min_angle)) {
+      out << "  vertebra angle: " << FormatFixed(min_angle, 4) << " .. "
+          << FormatFixed(max_angle, 4) << " rad (calibration " << calibration->Brief() << ")\n";
+    }
+  }
+
+  if (!command.convert_path.empty()) {
+    const Status written = WriteControllerLog(command.convert_path, *log);
+    if (!written.ok()) return ReportError(written, err);
+    err << "wrote " << command.convert_path.string() << '\n';
+  }
+  return kExitOk;
+}
+
+Subcommand AddLogCommand(CLI::App& parent) {
+  auto command = std::make_shared<LogCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "log", "What a controller log holds; optionally convert it to liftoff's format");
+  app->add_option("log", command->log_path, "Controller log")->required();
+  app->add_option("--log-format", command->log_format, "auto, liftoff or laika-2018")
+      ->capture_default_str();
+  AddCalibrationFlag(*app, command->calibration);
+  app->add_option("--max-bad-lines", command->max_bad_lines, "Malformed lines to skip (reported)")
+      ->capture_default_str();
+  app->add_option("--gap-threshold", command->gap_threshold_s, "Gap threshold, seconds")
+      ->capture_default_str();
+  app->add_option("--convert", command->convert_path, "Write the log in liftoff's format here");
+  app->add_flag("--json", command->json, "JSON output");
+  return RunsWith(app, command, RunLog);
+}
+
+}  // namespace liftoff::cli

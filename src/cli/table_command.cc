@@ -1,0 +1,218 @@
+// `liftoff table`: the campaign's per-trial and per-foot tables.
+#include "liftoff/cli/commands.h"
+
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "liftoff/capture/laika2018.h"
+#include "liftoff/cli/video_commands.h"
+#include "liftoff/core/output.h"
+#include "liftoff/core/file.h"
+#include "liftoff/core/json.h"
+#include "liftoff/stats/plot.h"
+#include "liftoff/stats/sim_results.h"
+#include "liftoff/stats/table.h"
+#include "liftoff/sync/trial_analysis.h"
+#include "liftoff/video/verification.h"
+
+namespace liftoff::cli {
+namespace {
+
+// Sends finished text to the output file, or to `out` when none is named.
+int Emit(const std::string& text, const std::filesystem::path& output_path, std::ostream& out,
+         std::ostream& err) {
+  if (output_path.empty()) {
+    out << text;
+    return kExitOk;
+  }
+  const Status written = WriteFileAtomically(output_path, text);
+  if (!written.ok()) return ReportError(written, err);
+  err << "wrote " << output_path.string() << '\n';
+  return kExitOk;
+}
+
+// what `table` writes: the tables, the plot, a verification image per trial with a video
+std::vector<NamedPath> TableOutputs(const TableCommand& command, const TrialManifest& manifest) {
+  std::vector<NamedPath> outputs = {{"--output", command.output_path},
+                                    {"--plot", command.plot_path}};
+  if (command.verify_dir.empty()) return outputs;
+  for (const TrialRecord& trial : manifest.trials) {
+    if (!trial.video_path) continue;
+    outputs.push_back({"--verify-dir", TrialVerificationPath(command.verify_dir, trial.id)});
+  }
+  return outputs;
+}
+
+// what `table` reads: the manifest (or the 2018 folder's times), the calibration, the
+// simulation results, every trial's log and video
+std::vector<NamedPath> TableInputs(const TableCommand& command, const TrialManifest& manifest,
+                                   const Calibration& calibration) {
+  std::vector<NamedPath> inputs = TrialInputs(manifest);
+  std::error_code error;
+  inputs.push_back({"MANIFEST", std::filesystem::is_directory(command.manifest_path, error)
+                                    ? command.manifest_path / capture::kLaika2018TimesCsv
+                                    : command.manifest_path});
+  inputs.push_back({"calibration", calibration.source_path});
+  inputs.push_back({"--sim", command.sim_path});
+  return inputs;
+}
+
+// The lines about one trial a person should see: log warnings, the video's brief and
+// warnings, the failure, the lookup's notes.
+void PrintOutcomeNotes(const sync::TrialOutcome& outcome, std::ostream& err) {
+  PrintLogWarnings(outcome.log_report, err);
+  if (outcome.video) {
+    err << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
+    for (const std::string& warning : outcome.video->warnings) {
+      err << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
+    }
+  }
+  if (!outcome.status.ok()) {
+    err << "error: " << outcome.status.ToString() << '\n';
+    return;
+  }
+  for (const std::string& warning : outcome.measurement->lookup.warnings) {
+    err << "note: " << outcome.trial.id << ": " << warning << '\n';
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// liftoff table
+
+Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
+                                         const CalibrationChoice& calibration_choice,
+                                         const LookupChoice& lookup_choice,
+                                         std::string_view progress_mode, std::ostream& err) {
+  // options, then inputs: manifest (or a 2018 folder read as one) and calibration
+  auto lookup = LookupOptionsFrom(lookup_choice);
+  if (!lookup.ok()) return lookup.status();
+  auto progress = VideoProgress::Create(progress_mode, err);
+  if (!progress.ok()) return progress.status();
+  CampaignAnalysis campaign;
+  auto manifest = LoadTrials(manifest_path, err);
+  if (!manifest.ok()) return manifest.status();
+  campaign.manifest = std::move(manifest).value();
+  auto calibration = ChooseCalibration(
+      calibration_choice, campaign.manifest.calibration_path.value_or(std::filesystem::path()));
+  if (!calibration.ok()) return calibration.status();
+  campaign.calibration = std::move(calibration).value();
+
+  // every trial through sync (videos without times through video analysis)
+  sync::AnalysisOptions options;
+  options.lookup = *lookup;
+  options.log.max_bad_lines = lookup_choice.max_bad_lines;
+  options.video_progress = [&](const TrialRecord& trial, int64_t frames_done, int64_t t_ns) {
+    progress->Show(trial.id, frames_done, t_ns);
+  };
+  campaign.analysis = sync::AnalyzeManifest(campaign.manifest, campaign.calibration, options);
+  progress->Done();
+
+  // what a person should know about each trial, on `err` and kept per trial
+  for (const sync::TrialOutcome& outcome : campaign.analysis.outcomes) {
+    std::ostringstream lines;
+    PrintOutcomeNotes(outcome, lines);
+    err << lines.str();
+    std::vector<std::string>& notes = campaign.notes.emplace_back();
+    std::istringstream split(lines.str());
+    for (std::string line; std::getline(split, line);) notes.push_back(line);
+    if (!outcome.status.ok() && campaign.first_failure.ok()) {
+      campaign.first_failure = outcome.status;
+    }
+  }
+  return campaign;
+}
+
+int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) {
+  // flags
+  const auto format = TableFormatFlag(command.format);
+  if (!format.ok()) return ReportError(format.status(), err);
+  if (command.tables != "both" && command.tables != "trials" && command.tables != "feet") {
+    return ReportError(InvalidArgumentError("--tables: expected both, trials or feet, got \"" +
+                                            command.tables + "\""),
+                       err);
+  }
+  std::optional<stats::SimResults> sim = command.sim_results;
+  if (!sim && !command.sim_path.empty()) {
+    auto loaded = stats::LoadSimResults(command.sim_path);
+    if (!loaded.ok()) return ReportError(loaded.status(), err);
+    sim = std::move(loaded).value();
+  }
+
+  // every trial; failures are reported and the rest still tabulated
+  auto campaign = AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup,
+                                  command.progress, err);
+  if (!campaign.ok()) return ReportError(campaign.status(), err);
+  // nothing is written before this: no output may be one of the inputs
+  if (const int refused = RefuseToOverwriteInputs(
+          TableOutputs(command, campaign->manifest),
+          TableInputs(command, campaign->manifest, campaign->calibration), err);
+      refused != kExitOk) {
+    return refused;
+  }
+  const sync::ManifestAnalysis& analysis = campaign->analysis;
+  const Status first_failure = campaign->first_failure;
+
+  // tables
+  const std::vector<stats::TrialValue> values = analysis.Values();
+  const std::string rule_name(sync::LookupRuleName(analysis.rule));
+  const stats::ResultsTable table =
+      stats::BuildResultsTable(values, sim ? &*sim : nullptr, analysis.calibration, rule_name);
+  std::string text;
+  if (command.tables == "trials") {
+    text = stats::RenderTrialTable(values, *format, analysis.calibration, rule_name);
+  } else if (command.tables == "feet" || *format == stats::TableFormat::kJson) {
+    text = stats::RenderResultsTable(table, *format);  // JSON holds the trials too
+  } else {
+    text = stats::RenderTrialTable(values, *format, analysis.calibration, rule_name) + "\n" +
+           stats::RenderResultsTable(table, *format);
+  }
+  const int emitted = Emit(text, command.output_path, out, err);
+  if (emitted != kExitOk) return emitted;
+  Status verified;
+  if (!command.verify_dir.empty()) {
+    verified = WriteTrialVerifications(analysis, command.verify_dir, err);
+  }
+  if (!command.plot_path.empty() && verified.ok()) {
+    auto plot = stats::RenderResultsPlotSvg(table);
+    verified = plot.ok() ? WriteFileAtomically(command.plot_path, *plot) : plot.status();
+    if (verified.ok()) err << "wrote " << command.plot_path.string() << '\n';
+  }
+
+  if (!first_failure.ok()) {
+    err << "liftoff: " << analysis.failed() << " of " << analysis.outcomes.size()
+        << " trials failed; the table holds the others\n";
+    return ExitCodeFor(first_failure.code());
+  }
+  return verified.ok() ? kExitOk : ExitCodeFor(verified.code());
+}
+
+Subcommand AddTableCommand(CLI::App& parent) {
+  auto command = std::make_shared<TableCommand>();
+  CLI::App* app = parent.add_subcommand(
+      "table", "Rotation at liftoff per trial and the per-foot table (paper Table IV layout)");
+  app->add_option("manifest", command->manifest_path,
+                  "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
+      ->required();
+  AddCalibrationFlag(*app, command->calibration);
+  AddLookupFlags(*app, command->lookup);
+  app->add_option("--format,-f", command->format, "md, csv, latex or json")->capture_default_str();
+  app->add_option("--tables", command->tables, "both, trials or feet")->capture_default_str();
+  app->add_option("--sim", command->sim_path, "Simulation results JSON for the sim columns");
+  app->add_option("--output,-o", command->output_path, "Write here instead of stdout");
+  app->add_option("--plot", command->plot_path,
+                  "Write the hardware-vs-simulation plot here (SVG)");
+  app->add_option("--verify-dir", command->verify_dir,
+                  "Write a verification image per video-analysed trial here (<id>.png)");
+  app->add_option("--progress", command->progress,
+                  "Video analysis progress on stderr: auto, live, lines or off")
+      ->capture_default_str();
+  return RunsWith(app, command, RunTable);
+}
+
+}  // namespace liftoff::cli

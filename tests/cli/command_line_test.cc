@@ -1,0 +1,131 @@
+// The command table: every flag of every command shows its struct's real default in the
+// help, and giving that default changes nothing.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "liftoff/cli/command_table.h"
+#include "liftoff/cli/sim_commands.h"
+#include "liftoff/cli/video_commands.h"
+#include "liftoff/core/json.h"
+
+namespace liftoff::cli {
+namespace {
+
+// "sim run" for the run subcommand, "table" for table
+std::vector<std::string> CommandPath(const CLI::App* app) {
+  std::vector<std::string> path;
+  for (; app->get_parent() != nullptr; app = app->get_parent()) {
+    path.insert(path.begin(), app->get_name());
+  }
+  return path;
+}
+
+// every option's current value (its field, read through the binding), by name
+std::map<std::string, std::string> CurrentValues(CLI::App* app) {
+  std::map<std::string, std::string> values;
+  for (CLI::Option* option : app->get_options()) {
+    option->capture_default_str();
+    values[option->get_name()] = option->get_default_str();
+  }
+  return values;
+}
+
+TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
+  CLI::App shown;
+  const std::vector<Subcommand> commands = AddCommands(shown);
+  CLI::App reference_app;
+  std::vector<Subcommand> reference = AddCommands(reference_app);
+  ASSERT_EQ(commands.size(), 15u);
+  int checked = 0;
+  for (size_t c = 0; c < commands.size(); ++c) {
+    const std::map<std::string, std::string> defaults = CurrentValues(reference[c].app);
+    for (const CLI::Option* option : commands[c].app->get_options()) {
+      const std::string& help_default = option->get_default_str();
+      if (!option->nonpositional() || help_default.empty()) continue;
+      const std::string name = option->get_name();
+      EXPECT_EQ(help_default, defaults.at(name)) << name;
+      // the shown default, given on the command line, leaves every field as it was
+      CLI::App given_app;
+      std::vector<Subcommand> given = AddCommands(given_app);
+      std::vector<std::string> arguments = CommandPath(given[c].app);
+      arguments.push_back(name + "=" + help_default);
+      std::reverse(arguments.begin(), arguments.end());  // CLI11 takes them last first
+      try {
+        given_app.parse(arguments);
+      } catch (const CLI::RequiredError&) {
+        // the command's positional arguments: the flags are read before that check
+      }
+      EXPECT_EQ(CurrentValues(given[c].app), defaults) << name << "=" << help_default;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(CommandLine, NoHelpTextTypesInANumericDefault) {
+  CLI::App app;
+  const std::vector<Subcommand> commands = AddCommands(app);
+  const std::regex typed_in(R"(default:? -?[0-9])");
+  for (const Subcommand& command : commands) {
+    for (const CLI::Option* option : command.app->get_options()) {
+      EXPECT_FALSE(std::regex_search(option->get_description(), typed_in))
+          << option->get_name() << ": " << option->get_description();
+    }
+  }
+}
+
+TEST(CommandLine, ExperimentFlagsShowTheExperimentsDefaultsInTheirUnits) {
+  CLI::App app;
+  const std::vector<Subcommand> commands = AddCommands(app);
+  const CLI::App* run = app.get_subcommand("sim")->get_subcommand("run");
+  const sim::ExperimentOptions defaults;
+  auto shown = [&](const std::string& flag) { return run->get_option(flag)->get_default_str(); };
+  // converted by hand from the struct's SI fields
+  EXPECT_EQ(shown("--ramp-deg"), FormatNumber(defaults.ramp_angle_rad * 180.0 / std::numbers::pi));
+  EXPECT_EQ(shown("--ramp-deg"), "60");
+  EXPECT_EQ(shown("--threshold-mm"), FormatNumber(defaults.liftoff_threshold_m * 1000.0));
+  EXPECT_EQ(shown("--ground-clearance-mm"), FormatNumber(defaults.ground_clearance_m * 1000.0));
+  EXPECT_EQ(shown("--dt"), FormatNumber(defaults.engine.time_step_s));
+  EXPECT_EQ(shown("--bend-fraction"), FormatNumber(defaults.bend_fraction));
+  EXPECT_EQ(shown("--solver-iterations"), std::to_string(defaults.engine.solver_iterations));
+  EXPECT_EQ(shown("--pretension-ratios"), "0.006,0.015,0.052,0.004");
+  // unset optionals: the model file's, no default shown
+  EXPECT_EQ(shown("--friction"), "");
+  EXPECT_EQ(shown("--attachment"), "");
+  // every experiment flag is on each sim command and the report
+  for (const FieldFlag<sim::ExperimentOptions>& flag : ExperimentFlags()) {
+    for (const char* command : {"run", "sweep", "export-mjcf"}) {
+      EXPECT_NO_THROW(app.get_subcommand("sim")->get_subcommand(command)->get_option(flag.flag))
+          << command << " " << flag.flag;
+    }
+    EXPECT_NO_THROW(app.get_subcommand("report")->get_option(flag.flag)) << flag.flag;
+  }
+}
+
+TEST(ClipOptionsFrom, ReadsRegionsAsXYWHAndNamesTheFlagOtherwise) {
+  ClipChoice choice;
+  choice.led_roi = "563,45,26,27";
+  choice.foot_roi = "300,520,160,120";
+  auto options = ClipOptionsFrom(choice);
+  ASSERT_TRUE(options.ok()) << options.status().ToString();
+  EXPECT_EQ(options->led.roi_px, cv::Rect(563, 45, 26, 27));
+  EXPECT_EQ(options->foot.foot_roi_px, cv::Rect(300, 520, 160, 120));
+  for (const char* bad : {"1,2,3", "1,2,3,4,5", "1,2,0,4", "-1,2,3,4", "a,b,c,d", "1,2,3,4 "}) {
+    choice.foot_roi = bad;
+    auto parsed = ClipOptionsFrom(choice);
+    EXPECT_EQ(parsed.status().code(), StatusCode::kInvalidArgument) << bad;
+    EXPECT_THAT(parsed.status().message(), ::testing::HasSubstr("--foot-roi: expected x,y,w,h"))
+        << bad;
+  }
+}
+
+}  // namespace
+}  // namespace liftoff::cli
