@@ -1275,12 +1275,14 @@ std::vector<cv::Rect> LedDetector::RegionsRead(cv::Size frame_px) const {
   const cv::Rect whole(cv::Point(0, 0), frame_px);
   const cv::Rect& roi = impl_->options.roi_px;
   if (impl_->located || (roi & whole) != roi) return {whole};
-  // the ROI's rows across the frame (the ROI and its strips), and the reference cells' rows
+  // the ROI's rows across the frame (the ROI and its strips), and the reference cells
   std::vector<cv::Rect> regions = {cv::Rect(0, roi.y, frame_px.width, roi.height)};
   const int cell_px = impl_->options.cell_px;
   if (frame_px.width < cell_px || frame_px.height < cell_px) return {whole};
   const Grid grid = Grid::Make(frame_px.width, frame_px.height, cell_px, kReferenceStride);
-  for (const int y0 : grid.y0_px) regions.emplace_back(0, y0, frame_px.width, cell_px);
+  for (const int y0 : grid.y0_px) {
+    for (const int x0 : grid.x0_px) regions.emplace_back(x0, y0, cell_px, cell_px);
+  }
   return regions;
 }
 

@@ -142,8 +142,8 @@ class LedDetector {
   /// ROI is not inside the frame ("LED ROI 40x40 at (700, 20) is outside the 640x480 frame").
   Status Process(const Frame& frame);
   /// The parts of a `frame_px` frame that Process reads: with an ROI, the rows it spans
-  /// (and the frame beside it, for the lighting) and the bands of reference cells; without
-  /// one, the whole frame. A reader need convert only these (VideoReader::ConvertOnly).
+  /// (and the frame beside it, for the lighting) and the reference cells; without one, the
+  /// whole frame. A reader need convert only these (VideoReader::ConvertOnly).
   std::vector<cv::Rect> RegionsRead(cv::Size frame_px) const;
   /// The result. kNotFound "the LED never switches on" when no pulse was found (with the
   /// best candidate's contrast in the message); kInvalidArgument when no frame was fed.
