@@ -134,8 +134,7 @@ ParsedLine ParseLine(std::string_view content, const ColumnIndex& index,
 Result<ControllerLog> ReadCsvLog(const fs::path& path, const CsvLogColumns& columns,
                                  const LogReadOptions& options) {
   const std::string file = path.string();
-  if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(file);
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(path));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, internal::ReadLogText(path, options));
   ControllerLog log;
   log.header.source = "csv " + path.filename().string();
   log.report.source = path;
@@ -143,8 +142,7 @@ Result<ControllerLog> ReadCsvLog(const fs::path& path, const CsvLogColumns& colu
 
   const std::vector<TextLine> lines = SplitLines(text);
   std::optional<ColumnIndex> index;
-  int64_t first_bad_line = 0, counted_bad_lines = 0;
-  std::string first_bad_reason;
+  internal::BadLines bad_lines;
   for (const TextLine& line : lines) {
     const std::string_view content = Trim(line.text);
     if (content.empty()) continue;
@@ -166,21 +164,13 @@ Result<ControllerLog> ReadCsvLog(const fs::path& path, const CsvLogColumns& colu
         AddIssue(log.report, options, line.number, "truncated last line, got " + Quote(content));
         continue;
       }
-      if (counted_bad_lines++ == 0) {
-        first_bad_line = line.number;
-        first_bad_reason = parsed.bad;
-      }
-      AddIssue(log.report, options, line.number, std::move(parsed.bad));
+      bad_lines.Add(log.report, options, line.number, std::move(parsed.bad));
       continue;
     }
     log.samples.push_back(parsed.sample);
   }
 
-  if (counted_bad_lines > options.max_bad_lines) {
-    return ParseError(file + ":" + std::to_string(first_bad_line) + ": " + first_bad_reason + " (" +
-                      Plural(counted_bad_lines, "bad line") + " in all; at most " +
-                      std::to_string(options.max_bad_lines) + " allowed)");
-  }
+  LIFTOFF_RETURN_IF_ERROR(bad_lines.Check(file, options));
   if (log.samples.empty()) {
     return ParseError(file + ": no samples (" + Plural(log.report.lines_total, "line") +
                       " after the header, " + Plural(log.report.bad_lines, "bad line") + ")");

@@ -177,8 +177,7 @@ Result<CsvRow> ParseCsvRow(std::string_view line_text, int64_t line, const std::
 Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration& calibration,
                                          const LogReadOptions& options) {
   const std::string file = path.string();
-  if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(file);
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(path));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, internal::ReadLogText(path, options));
 
   ControllerLog log;
   log.header.calibration = calibration.name;
@@ -194,9 +193,7 @@ Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration
     if (!Trim(line.text).empty()) last_content_line = line.number;
   }
 
-  int64_t first_bad_line = 0;  // first bad line that counts against max_bad_lines
-  std::string first_bad_reason;
-  int64_t counted_bad_lines = 0;
+  internal::BadLines bad_lines;
   bool seen_trailing_comma = false;
   std::string_view previous_time_text;  // of the last kept sample, for messages
   for (const TextLine& line : lines) {
@@ -222,11 +219,7 @@ Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration
                ", got " + Quote(content.substr(0, content.find(',')));
     }
     if (!reason.empty()) {
-      if (counted_bad_lines++ == 0) {
-        first_bad_line = line.number;
-        first_bad_reason = reason;
-      }
-      AddIssue(log.report, options, line.number, std::move(reason));
+      bad_lines.Add(log.report, options, line.number, std::move(reason));
       continue;
     }
     // keep the sample
@@ -238,12 +231,7 @@ Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration
     kept.vertebra_rad = calibration.VertebraAngleFromShaftAngle(sample->shaft_rad);
   }
 
-  if (counted_bad_lines > options.max_bad_lines) {
-    return ParseError(file + ":" + std::to_string(first_bad_line) + ": " + first_bad_reason + " (" +
-                      Plural(counted_bad_lines, "bad line") +
-                      " in all, not counting a truncated last line; at most " +
-                      std::to_string(options.max_bad_lines) + " allowed)");
-  }
+  LIFTOFF_RETURN_IF_ERROR(bad_lines.Check(file, options, "not counting a truncated last line"));
   if (log.samples.empty()) {
     return ParseError(file + ": no samples (" + Plural(log.report.lines_total, "non-blank line") +
                       ", " + Plural(log.report.bad_lines, "bad line") + ")");

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <system_error>
 
+#include "liftoff/core/file.h"
+#include "liftoff/core/text.h"
+
 namespace liftoff::capture::internal {
 
 // Splits at CR LF, bare CR or bare LF (the 2018 files use all three).
@@ -46,6 +49,11 @@ std::optional<double> ParseNumber(std::string_view text) {
   return value;
 }
 
+Result<std::string> ReadLogText(const std::filesystem::path& path, const LogReadOptions& options) {
+  if (Status valid = options.Validate(); !valid.ok()) return valid.WithContext(path.string());
+  return ReadWholeFile(path);
+}
+
 // Records a skipped line in the report.
 void AddIssue(LogReadReport& report, const LogReadOptions& options, int64_t line,
               std::string reason) {
@@ -53,6 +61,24 @@ void AddIssue(LogReadReport& report, const LogReadOptions& options, int64_t line
   if (static_cast<int64_t>(report.issues.size()) < options.max_issues_kept) {
     report.issues.push_back({line, std::move(reason)});
   }
+}
+
+void BadLines::Add(LogReadReport& report, const LogReadOptions& options, int64_t line,
+                   std::string reason) {
+  if (count_++ == 0) {
+    first_line_ = line;
+    first_reason_ = reason;
+  }
+  AddIssue(report, options, line, std::move(reason));
+}
+
+Status BadLines::Check(const std::string& file, const LogReadOptions& options,
+                       std::string_view note) const {
+  if (count_ <= options.max_bad_lines) return Status::Ok();
+  return ParseError(file + ":" + std::to_string(first_line_) + ": " + first_reason_ + " (" +
+                    Plural(count_, "bad line") + " in all" +
+                    (note.empty() ? std::string() : ", " + std::string(note)) + "; at most " +
+                    std::to_string(options.max_bad_lines) + " allowed)");
 }
 
 }  // namespace liftoff::capture::internal

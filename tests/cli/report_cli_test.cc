@@ -50,13 +50,7 @@ ReportCommand SampleReport(const fs::path& dir) {
   return command;
 }
 
-bool GnuplotOnPath() {
-  std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
-  for (std::string folder; std::getline(path, folder, ':');) {
-    if (!folder.empty() && fs::exists(fs::path(folder) / "gnuplot")) return true;
-  }
-  return false;
-}
+bool GnuplotOnPath() { return liftoff::testing::FindOnPath("gnuplot").has_value(); }
 
 // CSV rows (no quoting in these files' numeric rows), the header first
 std::vector<std::vector<std::string>> CsvRows(const std::string& text) {

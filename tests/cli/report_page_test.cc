@@ -28,11 +28,8 @@ using liftoff::testing::WriteFile;
 
 // Chromium on PATH, or empty
 fs::path FindChromium() {
-  std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
-  for (std::string folder; std::getline(path, folder, ':');) {
-    for (const char* name : {"chromium", "chromium-browser"}) {
-      if (!folder.empty() && fs::exists(fs::path(folder) / name)) return fs::path(folder) / name;
-    }
+  for (const char* name : {"chromium", "chromium-browser"}) {
+    if (auto found = liftoff::testing::FindOnPath(name)) return *found;
   }
   return {};
 }

@@ -14,6 +14,16 @@ std::filesystem::path SourceDir() {
   return LIFTOFF_SOURCE_DIR;
 }
 
+std::optional<std::filesystem::path> FindOnPath(const std::string& name) {
+  std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
+  for (std::string folder; std::getline(path, folder, ':');) {
+    if (!folder.empty() && std::filesystem::exists(std::filesystem::path(folder) / name)) {
+      return std::filesystem::path(folder) / name;
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<std::filesystem::path> ReferenceDir() {
   std::filesystem::path dir;
   if (const char* env = std::getenv("LIFTOFF_REFERENCE_DIR")) {

@@ -19,6 +19,9 @@ std::filesystem::path SourceDir();
 /// ../shared/reference next to the source tree (or $LIFTOFF_REFERENCE_DIR), when present.
 std::optional<std::filesystem::path> ReferenceDir();
 
+/// The program `name` in a folder of PATH, or nullopt.
+std::optional<std::filesystem::path> FindOnPath(const std::string& name);
+
 /// A fresh empty folder for one test, removed when the object is destroyed.
 class ScratchDir {
  public:
