@@ -1,6 +1,7 @@
 #include "liftoff/capture/csv_log.h"
 
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,7 +22,7 @@ using internal::SplitLines;
 using internal::TextLine;
 using internal::Trim;
 
-constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // whole encoder counts beyond this are not exact in a double
 constexpr double kMaxCounts = 9007199254740992.0;  // 2^53
 
