@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <tuple>
+#include <utility>
 
 #include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
 
 namespace liftoff::sync {
 namespace {
@@ -17,11 +18,7 @@ struct AnglePoint {
   double vertebra_rad;
 };
 
-std::string Rad(double value_rad) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.4f", value_rad);
-  return buffer;
-}
+std::string Rad(double value_rad) { return FormatFixed(value_rad, 4); }
 
 std::string Sec(int64_t ns) { return FormatSeconds(ns, 3) + " s"; }
 
@@ -110,18 +107,21 @@ Status CheckLogTime(std::string_view what, int64_t time_ns) {
                          " ns: expected a time within +-4e18 ns (about 127 years)");
 }
 
-}  // namespace
+// the first and last samples that carry an angle
+struct AngleEnds {
+  AnglePoint first;
+  AnglePoint last;
+};
 
-Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_ns,
-                                        int64_t query_uncertainty_ns,
-                                        const LookupOptions& options) {
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
-  if (query_uncertainty_ns < 0) {
-    return InvalidArgumentError("query uncertainty: expected >= 0 ns, got " +
-                                std::to_string(query_uncertainty_ns));
-  }
+// the query's uncertainty window, [begin_ns, end_ns] around query_ns
+struct QueryWindow {
+  int64_t query_ns;
+  int64_t uncertainty_ns;
+  int64_t begin_ns;
+  int64_t end_ns;
+};
 
-  // the first and last samples that carry an angle
+Result<AngleEnds> FindAngleEnds(const ControllerLog& log) {
   if (log.samples.empty()) return NotFoundError("the log has no samples");
   const auto has_angle = [](const LogSample& sample) { return !std::isnan(sample.vertebra_rad); };
   const auto first_sample = std::find_if(log.samples.begin(), log.samples.end(), has_angle);
@@ -130,17 +130,16 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
                          " samples has a vertebra angle");
   }
   const auto last_sample = std::find_if(log.samples.rbegin(), log.samples.rend(), has_angle);
-  const AnglePoint first{first_sample->device_time_ns, first_sample->vertebra_rad};
-  const AnglePoint last{last_sample->device_time_ns, last_sample->vertebra_rad};
-  // times within +-kMaxLogTimeNs: no difference below can overflow
-  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's first sample", log.samples.front().device_time_ns));
-  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's last sample", log.samples.back().device_time_ns));
-  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant looked up", query_ns));
-  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant's uncertainty", query_uncertainty_ns));
+  return AngleEnds{{first_sample->device_time_ns, first_sample->vertebra_rad},
+                   {last_sample->device_time_ns, last_sample->vertebra_rad}};
+}
+
+// kOutOfRange for a query more than max_past_end_s outside the log
+Status CheckQueryNearLog(int64_t query_ns, const AngleEnds& ends, const LookupOptions& options) {
+  const AnglePoint& first = ends.first;
+  const AnglePoint& last = ends.last;
   const std::string span =
       "(log spans " + FormatSeconds(first.time_ns) + "-" + FormatSeconds(last.time_ns) + " s)";
-
-  // queries too far outside the log
   const int64_t tolerance_ns = NsFromSeconds(options.max_past_end_s);
   const std::string limit = "; at most max_past_end_s = " + FormatSeconds(tolerance_ns) +
                             " s outside the log is answered";
@@ -152,18 +151,32 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
     return OutOfRangeError("instant " + Sec(query_ns) + " is before the log's first sample at " +
                            Sec(first.time_ns) + " " + span + limit);
   }
+  return Status::Ok();
+}
 
-  // the samples around the query's window; every step below works on these
-  const std::vector<AnglePoint> points = AnglePointsAround(
-      log.samples, query_ns - query_uncertainty_ns, query_ns + query_uncertainty_ns);
+// The checks before a lookup: options, uncertainty, a log with angles, times that cannot
+// overflow, a query near enough the log. Returns the log's ends.
+Result<AngleEnds> CheckLookup(const ControllerLog& log, int64_t query_ns,
+                              int64_t query_uncertainty_ns, const LookupOptions& options) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  if (query_uncertainty_ns < 0) {
+    return InvalidArgumentError("query uncertainty: expected >= 0 ns, got " +
+                                std::to_string(query_uncertainty_ns));
+  }
+  LIFTOFF_ASSIGN_OR_RETURN(const AngleEnds ends, FindAngleEnds(log));
+  // times within +-kMaxLogTimeNs: no difference in the lookup can overflow
+  LIFTOFF_RETURN_IF_ERROR(
+      CheckLogTime("the log's first sample", log.samples.front().device_time_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's last sample", log.samples.back().device_time_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant looked up", query_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the instant's uncertainty", query_uncertainty_ns));
+  LIFTOFF_RETURN_IF_ERROR(CheckQueryNearLog(query_ns, ends, options));
+  return ends;
+}
 
-  AngleLookup lookup;
-  lookup.rule = options.rule;
-  lookup.query_ns = query_ns;
-  lookup.query_uncertainty_ns = query_uncertainty_ns;
-  lookup.vertebra_rad = AngleAt(points, query_ns, options.rule);
-
-  // bracketing samples: last at or before, first at or after
+// bracketing samples: last at or before the query, first at or after
+void SetBracketingSamples(const std::vector<AnglePoint>& points, AngleLookup& lookup) {
+  const int64_t query_ns = lookup.query_ns;
   const auto at_or_after =
       std::lower_bound(points.begin(), points.end(), query_ns,
                        [](const AnglePoint& point, int64_t t) { return point.time_ns < t; });
@@ -173,25 +186,38 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
   } else if (at_or_after != points.begin()) {
     lookup.sample_before_ns = (at_or_after - 1)->time_ns;
   }
+}
 
-  // range of the rule's answer over the window: its ends and every sample inside
-  const int64_t window_begin_ns = query_ns - query_uncertainty_ns;
-  const int64_t window_end_ns = query_ns + query_uncertainty_ns;
-  const double at_window_begin_rad = AngleAt(points, window_begin_ns, options.rule);
-  const double at_window_end_rad = AngleAt(points, window_end_ns, options.rule);
+using PointIt = std::vector<AnglePoint>::const_iterator;
+
+// Range of the rule's answer over the window, into lookup.lower_rad/upper_rad: its ends and
+// every sample inside. Returns the samples strictly inside the window.
+std::pair<PointIt, PointIt> SetRangeOverWindow(const std::vector<AnglePoint>& points,
+                                               const QueryWindow& window, AngleLookup& lookup) {
+  const double at_window_begin_rad = AngleAt(points, window.begin_ns, lookup.rule);
+  const double at_window_end_rad = AngleAt(points, window.end_ns, lookup.rule);
   double lower = std::min({at_window_begin_rad, at_window_end_rad, lookup.vertebra_rad});
   double upper = std::max({at_window_begin_rad, at_window_end_rad, lookup.vertebra_rad});
-  const auto inside_begin =
-      std::upper_bound(points.begin(), points.end(), window_begin_ns,
+  const PointIt inside_begin =
+      std::upper_bound(points.begin(), points.end(), window.begin_ns,
                        [](int64_t t, const AnglePoint& point) { return t < point.time_ns; });
-  auto inside_end = inside_begin;
-  for (; inside_end != points.end() && inside_end->time_ns < window_end_ns; ++inside_end) {
+  PointIt inside_end = inside_begin;
+  for (; inside_end != points.end() && inside_end->time_ns < window.end_ns; ++inside_end) {
     lower = std::min(lower, inside_end->vertebra_rad);
     upper = std::max(upper, inside_end->vertebra_rad);
   }
+  lookup.lower_rad = lower;
+  lookup.upper_rad = upper;
+  return {inside_begin, inside_end};
+}
 
-  // gaps the window overlaps: the angle there is only known to lie between their ends
-  const int64_t gap_threshold_ns = NsFromSeconds(options.gap_threshold_s);
+// Gaps the window overlaps: the angle there is only known to lie between their ends. Widens
+// the range to them and reports one (the gap around the query, else the longest).
+void AddGapsOverlapped(const std::vector<AnglePoint>& points, PointIt inside_begin,
+                       PointIt inside_end, const QueryWindow& window, double gap_threshold_s,
+                       AngleLookup& lookup) {
+  const int64_t query_ns = window.query_ns;
+  const int64_t gap_threshold_ns = NsFromSeconds(gap_threshold_s);
   const auto scan_begin = inside_begin == points.begin() ? inside_begin : inside_begin - 1;
   const auto scan_end = inside_end == points.end() ? inside_end : inside_end + 1;
   const AnglePoint* gap_before = nullptr;  // the reported gap
@@ -201,9 +227,9 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
     const AnglePoint& after = *(it + 1);
     const int64_t gap_ns = after.time_ns - before.time_ns;
     if (gap_ns <= gap_threshold_ns) continue;
-    if (before.time_ns >= window_end_ns || after.time_ns <= window_begin_ns) continue;
-    lower = std::min({lower, before.vertebra_rad, after.vertebra_rad});
-    upper = std::max({upper, before.vertebra_rad, after.vertebra_rad});
+    if (before.time_ns >= window.end_ns || after.time_ns <= window.begin_ns) continue;
+    lookup.lower_rad = std::min({lookup.lower_rad, before.vertebra_rad, after.vertebra_rad});
+    lookup.upper_rad = std::max({lookup.upper_rad, before.vertebra_rad, after.vertebra_rad});
     const bool holds_query = before.time_ns < query_ns && query_ns < after.time_ns;
     if (gap_before == nullptr || (holds_query && !query_in_reported_gap) ||
         (holds_query == query_in_reported_gap && gap_ns > lookup.gap_ns)) {
@@ -212,26 +238,31 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
       query_in_reported_gap = holds_query;
     }
   }
-  if (gap_before != nullptr) {
-    lookup.in_gap = true;
-    const std::string where = "a " + FormatSeconds(lookup.gap_ns, 2) +
-                              " s gap between samples at " + Sec(gap_before->time_ns) + " and " +
-                              Sec(gap_before->time_ns + lookup.gap_ns);
-    lookup.warnings.push_back(query_in_reported_gap
-                                  ? "instant " + Sec(query_ns) + " is inside " + where
-                                  : "the window " + FormatSeconds(query_ns) + " +/- " +
-                                        Sec(query_uncertainty_ns) + " overlaps " + where);
-  }
+  if (gap_before == nullptr) return;
+  lookup.in_gap = true;
+  const std::string where = "a " + FormatSeconds(lookup.gap_ns, 2) + " s gap between samples at " +
+                            Sec(gap_before->time_ns) + " and " +
+                            Sec(gap_before->time_ns + lookup.gap_ns);
+  lookup.warnings.push_back(query_in_reported_gap
+                                ? "instant " + Sec(query_ns) + " is inside " + where
+                                : "the window " + FormatSeconds(query_ns) + " +/- " +
+                                      Sec(window.uncertainty_ns) + " overlaps " + where);
+}
 
-  // past either end: widen by the log's mean rate times the distance outside
+// Past either end: the end value is held, and the range widened by the log's mean rate
+// times the distance outside.
+void WidenPastEnds(const AngleEnds& ends, const QueryWindow& window, AngleLookup& lookup) {
+  const AnglePoint& first = ends.first;
+  const AnglePoint& last = ends.last;
+  const int64_t query_ns = window.query_ns;
   const int64_t span_ns = last.time_ns - first.time_ns;
   const double mean_rate_rad_per_s =
       span_ns > 0 ? std::abs(last.vertebra_rad - first.vertebra_rad) / SecondsFromNs(span_ns) : 0.0;
-  const int64_t after_end_ns = std::max<int64_t>(0, window_end_ns - last.time_ns);
-  const int64_t before_start_ns = std::max<int64_t>(0, first.time_ns - window_begin_ns);
+  const int64_t after_end_ns = std::max<int64_t>(0, window.end_ns - last.time_ns);
+  const int64_t before_start_ns = std::max<int64_t>(0, first.time_ns - window.begin_ns);
   const double widen_rad = mean_rate_rad_per_s * SecondsFromNs(after_end_ns + before_start_ns);
-  lower -= widen_rad;
-  upper += widen_rad;
+  lookup.lower_rad -= widen_rad;
+  lookup.upper_rad += widen_rad;
   lookup.past_end = query_ns > last.time_ns;
   lookup.before_start = query_ns < first.time_ns;
   if (lookup.past_end) {
@@ -240,7 +271,7 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
                               "; its value is held");
   } else if (after_end_ns > 0) {
     lookup.warnings.push_back("the window " + FormatSeconds(query_ns) + " +/- " +
-                              Sec(query_uncertainty_ns) + " reaches " + Sec(after_end_ns) +
+                              Sec(window.uncertainty_ns) + " reaches " + Sec(after_end_ns) +
                               " past the log's last sample at " + Sec(last.time_ns));
   }
   if (lookup.before_start) {
@@ -249,15 +280,39 @@ Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_
                               "; its value is held");
   } else if (before_start_ns > 0) {
     lookup.warnings.push_back("the window " + FormatSeconds(query_ns) + " +/- " +
-                              Sec(query_uncertainty_ns) + " reaches " + Sec(before_start_ns) +
+                              Sec(window.uncertainty_ns) + " reaches " + Sec(before_start_ns) +
                               " before the log's first sample at " + Sec(first.time_ns));
   }
   if (widen_rad > 0.0) {
     lookup.warnings.back() += "; interval widened by the log's mean rate " +
                               Rad(mean_rate_rad_per_s) + " rad/s to +/- " + Rad(widen_rad) + " rad";
   }
-  lookup.lower_rad = lower;
-  lookup.upper_rad = upper;
+}
+
+}  // namespace
+
+Result<AngleLookup> LookupVertebraAngle(const ControllerLog& log, int64_t query_ns,
+                                        int64_t query_uncertainty_ns,
+                                        const LookupOptions& options) {
+  LIFTOFF_ASSIGN_OR_RETURN(const AngleEnds ends,
+                           CheckLookup(log, query_ns, query_uncertainty_ns, options));
+  const QueryWindow window{query_ns, query_uncertainty_ns, query_ns - query_uncertainty_ns,
+                           query_ns + query_uncertainty_ns};
+
+  // the samples around the query's window; every step below works on these
+  const std::vector<AnglePoint> points =
+      AnglePointsAround(log.samples, window.begin_ns, window.end_ns);
+
+  // the answer at the query, then the range it can take over the window
+  AngleLookup lookup;
+  lookup.rule = options.rule;
+  lookup.query_ns = query_ns;
+  lookup.query_uncertainty_ns = query_uncertainty_ns;
+  lookup.vertebra_rad = AngleAt(points, query_ns, options.rule);
+  SetBracketingSamples(points, lookup);
+  const auto [inside_begin, inside_end] = SetRangeOverWindow(points, window, lookup);
+  AddGapsOverlapped(points, inside_begin, inside_end, window, options.gap_threshold_s, lookup);
+  WidenPastEnds(ends, window, lookup);
   return lookup;
 }
 
