@@ -467,6 +467,162 @@ Status LogReadOptions::Validate() const {
 // ---------------------------------------------------------------------------------------
 // reading
 
+namespace {
+
+// Reads a liftoff log's text into `log` in the file's order: the version line, the header,
+// the rows. Errors name file:line; a file cut off before its first row is an empty log.
+class LogParser {
+ public:
+  LogParser(std::string name, std::istream& in, const LogReadOptions& options, ControllerLog& log)
+      : name_(std::move(name)), lines_(in), options_(options), log_(log) {}
+
+  // "liftoff-log 1" (after an optional UTF-8 byte order mark)
+  Status ReadVersionLine() {
+    if (!lines_.Next(line_, has_line_end_)) return EmptyLog();
+    if (line_.starts_with(kUtf8ByteOrderMark)) line_.erase(0, kUtf8ByteOrderMark.size());
+    if (!has_line_end_ && std::string_view(kMagic).starts_with(line_)) return EmptyLog();
+    const std::string_view first = line_;
+    const std::string_view version_text =
+        first.starts_with(kMagic) ? Trim(first.substr(kMagic.size())) : "";
+    int version = 0;
+    if (!first.starts_with(std::string(kMagic) + " ") || !ParseInteger(version_text, version)) {
+      return ParseError(Where() + ": expected \"" + std::string(kMagic) + " " +
+                        std::to_string(kFormatVersion) + "\" as the first line, got " +
+                        Quote(line_));
+    }
+    if (version != kFormatVersion) {
+      return UnsupportedError(Where() + ": liftoff-log version " + std::to_string(version) +
+                              " is not supported; this build reads version " +
+                              std::to_string(kFormatVersion));
+    }
+    log_.header.version = version;
+    return Status::Ok();
+  }
+
+  // header lines "# key: value" up to the column header; other '#' lines are comments
+  Status ReadHeader() {
+    while (lines_.Next(line_, has_line_end_)) {
+      const std::string_view text = Trim(line_);
+      if (text.empty()) continue;
+      if (text.front() == '#') {
+        LIFTOFF_RETURN_IF_ERROR(ReadHeaderKey(Trim(text.substr(1))));
+        continue;
+      }
+      if (text == kColumnHeader) return Status::Ok();
+      if (!has_line_end_ && kColumnHeader.starts_with(text)) return EmptyLog();
+      return ParseError(Where() + ": expected the column header \"" + std::string(kColumnHeader) +
+                        "\", got " + Quote(line_));
+    }
+    return EmptyLog();
+  }
+
+  // rows: samples and events; bad ones skipped, counted and remembered
+  void ReadRows() {
+    while (lines_.Next(line_, has_line_end_)) {
+      if (Trim(line_).empty() || Trim(line_).front() == '#') continue;
+      ++log_.report.lines_total;
+      ReadRow(lines_.line_number(has_line_end_));
+    }
+  }
+
+  // too many bad lines, or nothing to work with
+  Status CheckVerdict() const {
+    const LogReadReport& report = log_.report;
+    const int64_t counted_bad = report.bad_lines - (report.truncated_last_line ? 1 : 0);
+    if (counted_bad > options_.max_bad_lines) {
+      return ParseError(first_bad_ + " (" + Plural(counted_bad, "bad line") +
+                        " in all, not counting a " + "truncated last line; at most " +
+                        std::to_string(options_.max_bad_lines) + " allowed)");
+    }
+    if (log_.samples.empty()) return EmptyLog();
+    return Status::Ok();
+  }
+
+ private:
+  std::string Where() const {
+    return name_ + ":" + std::to_string(lines_.line_number(has_line_end_));
+  }
+  Status EmptyLog() const { return ParseError(name_ + ": no samples (empty log)"); }
+
+  // the body of a '#' line: a "key: value" pair, or a comment
+  Status ReadHeaderKey(std::string_view body) {
+    const size_t colon = body.find(':');
+    if (colon == std::string_view::npos || !IsKey(body.substr(0, colon))) return Status::Ok();
+    const std::string key(body.substr(0, colon));
+    const std::string value(Trim(body.substr(colon + 1)));
+    if (!seen_keys_.insert(key).second) {
+      return ParseError(Where() + ": header key \"" + key + "\" appears twice");
+    }
+    if (key == "calibration") {
+      log_.header.calibration = value;
+    } else if (key == "source") {
+      log_.header.source = value;
+    } else if (key == "device") {
+      log_.header.device = value;
+    } else {
+      log_.header.metadata[key] = value;
+    }
+    return Status::Ok();
+  }
+
+  // the current line as a sample or an event, or skipped
+  void ReadRow(int64_t line_number) {
+    if (line_.size() > kMaxLineBytes) {
+      Skip(line_number,
+           "expected a line of at most " + std::to_string(kMaxLineBytes) +
+               " bytes, got a longer one",
+           false);
+      return;
+    }
+    ParseRow(line_, fields_, row_);
+    if (!row_.expected.empty()) {
+      Skip(line_number, row_.expected, !has_line_end_);
+      return;
+    }
+    if (row_.is_event) {
+      log_.events.push_back(std::move(row_.event));
+      return;
+    }
+    // samples run forward in device time; one that does not is dropped
+    std::vector<LogSample>& samples = log_.samples;
+    if (!samples.empty() && row_.sample.device_time_ns <= samples.back().device_time_ns) {
+      ++log_.report.out_of_order;
+      Skip(line_number,
+           "device_time_ns: expected more than the previous sample's " +
+               std::to_string(samples.back().device_time_ns) + ", got " +
+               Quote(std::to_string(row_.sample.device_time_ns)),
+           false);
+      return;
+    }
+    samples.push_back(row_.sample);
+  }
+
+  void Skip(int64_t line_number, std::string reason, bool truncated) {
+    LogReadReport& report = log_.report;
+    ++report.bad_lines;
+    if (truncated) report.truncated_last_line = true;
+    if (!truncated && first_bad_.empty())
+      first_bad_ = name_ + ":" + std::to_string(line_number) + ": " + reason;
+    if (std::ssize(report.issues) < options_.max_issues_kept) {
+      report.issues.push_back(
+          {line_number, truncated ? "truncated last line, got " + Quote(line_) : reason});
+    }
+  }
+
+  const std::string name_;
+  LineReader lines_;
+  const LogReadOptions& options_;
+  ControllerLog& log_;
+  std::string line_;
+  bool has_line_end_ = false;
+  std::set<std::string> seen_keys_;
+  std::string first_bad_;  // "file:line: expected ..., got ..." of the first bad line
+  std::vector<std::string> fields_;
+  ParsedRow row_;
+};
+
+}  // namespace
+
 Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
                                         const LogReadOptions& options) {
   const std::string name = path.string();
@@ -478,129 +634,21 @@ Result<ControllerLog> ReadControllerLog(const std::filesystem::path& path,
   ControllerLog log;
   log.report.source = path;
   log.report.format = "liftoff";
-  LineReader lines(in);
-  std::string line;
-  bool has_line_end = false;
-  const auto where = [&] { return name + ":" + std::to_string(lines.line_number(has_line_end)); };
-  const auto empty_log = [&] { return ParseError(name + ": no samples (empty log)"); };
-
-  // the version line (a file cut off before it is an empty log)
-  if (!lines.Next(line, has_line_end)) return empty_log();
-  if (line.starts_with(kUtf8ByteOrderMark)) line.erase(0, kUtf8ByteOrderMark.size());
-  if (!has_line_end && std::string_view(kMagic).starts_with(line)) return empty_log();
-  const std::string_view first = line;
-  const std::string_view version_text =
-      first.starts_with(kMagic) ? Trim(first.substr(kMagic.size())) : "";
-  int version = 0;
-  if (!first.starts_with(std::string(kMagic) + " ") || !ParseInteger(version_text, version)) {
-    return ParseError(where() + ": expected \"" + std::string(kMagic) + " " +
-                      std::to_string(kFormatVersion) + "\" as the first line, got " + Quote(line));
-  }
-  if (version != kFormatVersion) {
-    return UnsupportedError(where() + ": liftoff-log version " + std::to_string(version) +
-                            " is not supported; this build reads version " +
-                            std::to_string(kFormatVersion));
-  }
-  log.header.version = version;
-
-  // header lines "# key: value" up to the column header; other '#' lines are comments
-  bool have_columns = false;
-  std::set<std::string> seen_keys;
-  while (!have_columns && lines.Next(line, has_line_end)) {
-    const std::string_view text = Trim(line);
-    if (text.empty()) continue;
-    if (text.front() == '#') {
-      const std::string_view body = Trim(text.substr(1));
-      const size_t colon = body.find(':');
-      if (colon == std::string_view::npos || !IsKey(body.substr(0, colon))) continue;
-      const std::string key(body.substr(0, colon));
-      const std::string value(Trim(body.substr(colon + 1)));
-      if (!seen_keys.insert(key).second) {
-        return ParseError(where() + ": header key \"" + key + "\" appears twice");
-      }
-      if (key == "calibration") {
-        log.header.calibration = value;
-      } else if (key == "source") {
-        log.header.source = value;
-      } else if (key == "device") {
-        log.header.device = value;
-      } else {
-        log.header.metadata[key] = value;
-      }
-      continue;
-    }
-    if (text != kColumnHeader) {
-      if (!has_line_end && kColumnHeader.starts_with(text)) return empty_log();
-      return ParseError(where() + ": expected the column header \"" + std::string(kColumnHeader) +
-                        "\", got " + Quote(line));
-    }
-    have_columns = true;
-  }
-  if (!have_columns) return empty_log();
-
-  // rows: samples and events; bad ones skipped, counted and remembered. The samples are
-  // reserved once for every line ahead (a cheap pass over the file), so the vector never
-  // holds an old and a doubled copy at once
+  LogParser parser(name, in, options, log);
+  LIFTOFF_RETURN_IF_ERROR(parser.ReadVersionLine());
+  LIFTOFF_RETURN_IF_ERROR(parser.ReadHeader());
+  // the samples are reserved once for every line ahead (a cheap pass over the file), so the
+  // vector never holds an old and a doubled copy at once
   log.samples.reserve(CountLineEnds(path));
-  LogReadReport& report = log.report;
-  std::string first_bad;  // "file:line: expected ..., got ..." of the first bad line
-  const auto skip = [&](int64_t line_number, std::string reason, bool truncated) {
-    ++report.bad_lines;
-    if (truncated) report.truncated_last_line = true;
-    if (!truncated && first_bad.empty())
-      first_bad = name + ":" + std::to_string(line_number) + ": " + reason;
-    if (std::ssize(report.issues) < options.max_issues_kept) {
-      report.issues.push_back(
-          {line_number, truncated ? "truncated last line, got " + Quote(line) : reason});
-    }
-  };
-  std::vector<std::string> fields;
-  ParsedRow row;
-  while (lines.Next(line, has_line_end)) {
-    if (Trim(line).empty() || Trim(line).front() == '#') continue;
-    ++report.lines_total;
-    const int64_t line_number = lines.line_number(has_line_end);
-    if (line.size() > kMaxLineBytes) {
-      skip(line_number, "expected a line of at most " + std::to_string(kMaxLineBytes) +
-                            " bytes, got a longer one", false);
-      continue;
-    }
-    ParseRow(line, fields, row);
-    if (!row.expected.empty()) {
-      skip(line_number, row.expected, !has_line_end);
-      continue;
-    }
-    if (row.is_event) {
-      log.events.push_back(std::move(row.event));
-      continue;
-    }
-    // samples run forward in device time; one that does not is dropped
-    if (!log.samples.empty() && row.sample.device_time_ns <= log.samples.back().device_time_ns) {
-      ++report.out_of_order;
-      skip(line_number,
-           "device_time_ns: expected more than the previous sample's " +
-               std::to_string(log.samples.back().device_time_ns) + ", got " +
-               Quote(std::to_string(row.sample.device_time_ns)),
-           false);
-      continue;
-    }
-    log.samples.push_back(row.sample);
-  }
+  parser.ReadRows();
   if (in.bad()) return IoError(name + ": read failed");
+  LIFTOFF_RETURN_IF_ERROR(parser.CheckVerdict());
 
-  // verdict: too many bad lines, or nothing to work with
-  const int64_t counted_bad = report.bad_lines - (report.truncated_last_line ? 1 : 0);
-  if (counted_bad > options.max_bad_lines) {
-    return ParseError(first_bad + " (" + Plural(counted_bad, "bad line") +
-                      " in all, not counting a " + "truncated last line; at most " +
-                      std::to_string(options.max_bad_lines) + " allowed)");
-  }
-  if (log.samples.empty()) return empty_log();
   std::stable_sort(log.events.begin(), log.events.end(), [](const LogEvent& a, const LogEvent& b) {
     return a.device_time_ns < b.device_time_ns;
   });
-  report.samples = std::ssize(log.samples);
-  report.events = std::ssize(log.events);
+  log.report.samples = std::ssize(log.samples);
+  log.report.events = std::ssize(log.events);
   return log;
 }
 
