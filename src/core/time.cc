@@ -1,9 +1,11 @@
 #include "liftoff/core/time.h"
 
 #include <cmath>
-#include <cstdio>
 #include <ctime>
 #include <limits>
+#include <string>
+
+#include "liftoff/core/text.h"
 
 namespace liftoff {
 namespace {
@@ -70,16 +72,12 @@ Result<int64_t> ParseDecimalNs(std::string_view text, int64_t unit_ns) {
 
 std::string FormatMilliseconds(int64_t ns, int decimals) {
   assert(decimals >= 0 && decimals <= 9);
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.*f ms", decimals, 1e-6 * static_cast<double>(ns));
-  return buffer;
+  return FormatFixed(1e-6 * static_cast<double>(ns), decimals) + " ms";
 }
 
 std::string FormatSeconds(int64_t ns, int decimals) {
   assert(decimals >= 0 && decimals <= 9);
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, SecondsFromNs(ns));
-  return buffer;
+  return FormatFixed(SecondsFromNs(ns), decimals);
 }
 
 int64_t HostNowNs() {
