@@ -1,9 +1,10 @@
 #include "liftoff/stats/table.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include <nlohmann/json.hpp>
+
+#include "liftoff/core/text.h"
 
 namespace liftoff::stats {
 namespace {
@@ -16,9 +17,7 @@ using Row = std::vector<Cell>;
 
 Cell Fixed3(double value) {
   if (!std::isfinite(value)) return std::nullopt;
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3f", value);
-  return std::string(buffer);
+  return FormatFixed(value, 3);
 }
 
 Cell Interval(double low, double high) {
