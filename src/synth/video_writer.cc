@@ -171,6 +171,133 @@ struct VideoWriter::Impl {
       if (written < 0) return FailAv("writing a frame failed", written);
     }
   }
+
+  // --- opening, in order: contexts, encoder, file, colour conversion ---
+
+  // FFmpeg's encoder, muxer, frame and packet for `choice`
+  Status AllocateContexts(const CodecChoice& choice, const AVCodec*& codec) {
+    codec = avcodec_find_encoder_by_name(choice.encoder);
+    if (codec == nullptr) {
+      return UnsupportedError(Where() + ": this FFmpeg has no " + choice.encoder + " encoder");
+    }
+    const int created_format =
+        avformat_alloc_output_context2(&format, nullptr, choice.muxer, partial_path.c_str());
+    if (created_format < 0 || format == nullptr) {
+      return UnsupportedError(Where() + ": this FFmpeg has no " + choice.muxer +
+                              " muxer: " + AvErrorText(created_format));
+    }
+    encoder = avcodec_alloc_context3(codec);
+    frame = av_frame_alloc();
+    packet = av_packet_alloc();
+    if (encoder == nullptr || frame == nullptr || packet == nullptr) {
+      return IoError(Where() + ": out of memory");
+    }
+    return Status::Ok();
+  }
+
+  // the encoder's settings, common then per codec, and the encoder opened
+  Status OpenEncoder(const AVCodec* codec, const CodecChoice& choice) {
+    encoder->width = options.width_px;
+    encoder->height = options.height_px;
+    encoder->pix_fmt = choice.pixel_format;
+    encoder->time_base = ContainerTimeBase(options);
+    encoder->framerate = av_d2q(options.nominal_fps, 1'000'000);
+    encoder->gop_size = std::max(1, static_cast<int>(std::lround(options.nominal_fps)));
+    encoder->sample_aspect_ratio = {1, 1};
+    // bit-exact: no random segment id, no version strings; the same frames give the same bytes
+    format->flags |= AVFMT_FLAG_BITEXACT;
+    encoder->flags |= AV_CODEC_FLAG_BITEXACT;
+    if ((format->oformat->flags & AVFMT_GLOBALHEADER) != 0) {
+      encoder->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+    }
+    SetCodecSettings();
+    if (const int opened = avcodec_open2(encoder, codec, nullptr); opened < 0) {
+      return UnsupportedError(Where() + ": cannot open the " + choice.encoder +
+                              " encoder: " + AvErrorText(opened));
+    }
+    return Status::Ok();
+  }
+
+  void SetCodecSettings() {
+    switch (options.codec) {
+      case VideoCodec::kH264:
+        // b-adapt=0: every run of non-key frames uses both B-frames, whatever the content
+        encoder->max_b_frames = 2;
+        encoder->thread_count = 2;  // fixed, so the bytes do not depend on the machine
+        av_opt_set(encoder->priv_data, "preset", "veryfast", 0);
+        av_opt_set(encoder->priv_data, "crf", std::to_string(options.quality).c_str(), 0);
+        av_opt_set(encoder->priv_data, "x264-params", "b-adapt=0", 0);
+        break;
+      case VideoCodec::kMjpeg:
+        encoder->color_range = AVCOL_RANGE_JPEG;
+        encoder->flags |= AV_CODEC_FLAG_QSCALE;
+        encoder->global_quality = FF_QP2LAMBDA * options.quality;
+        break;
+      case VideoCodec::kFfv1:
+        // version 3 with 4 slices encodes the slices in parallel; slices, not threads,
+        // decide the bytes, so the output stays the same on any machine
+        encoder->thread_count = 2;
+        encoder->thread_type = FF_THREAD_SLICE;
+        av_opt_set_int(encoder->priv_data, "slices", 4, 0);
+        av_opt_set_int(encoder->priv_data, "slicecrc", 1, 0);
+        encoder->level = 3;
+        break;
+    }
+  }
+
+  // the stream, the .partial file and the container's header
+  Status OpenFile() {
+    stream = avformat_new_stream(format, nullptr);
+    if (stream == nullptr) return IoError(Where() + ": out of memory");
+    avcodec_parameters_from_context(stream->codecpar, encoder);
+    stream->time_base = encoder->time_base;
+    stream->avg_frame_rate = encoder->framerate;
+    if (const Status folder = CreateParentFolder(path); !folder.ok()) {
+      return IoError(Where() + ": cannot create the file: " + folder.message());
+    }
+    if (const int opened = avio_open(&format->pb, partial_path.c_str(), AVIO_FLAG_WRITE);
+        opened < 0) {
+      return IoError(Where() + ": cannot create the file: " + AvErrorText(opened));
+    }
+    created = true;
+    AVDictionary* muxer_options = nullptr;
+    if (options.codec == VideoCodec::kH264)
+      av_dict_set(&muxer_options, "movflags", "+faststart", 0);
+    const int header = avformat_write_header(format, &muxer_options);
+    av_dict_free(&muxer_options);
+    if (header < 0) {
+      return IoError(Where() + ": cannot write the header: " + AvErrorText(header));
+    }
+    // the muxer may have changed the stream's time base; packets are rescaled to it
+    // and StoredPtsNs() follows both roundings
+    return Status::Ok();
+  }
+
+  // frame buffer and colour conversion
+  Status PrepareConversion() {
+    frame->format = encoder->pix_fmt;
+    frame->width = encoder->width;
+    frame->height = encoder->height;
+    if (const int allocated = av_frame_get_buffer(frame, 0); allocated < 0) {
+      return IoError(Where() + ": cannot allocate a frame: " + AvErrorText(allocated));
+    }
+    // yuvj420p is yuv420p at full range; naming it that way keeps swscale from warning
+    const AVPixelFormat convert_to =
+        encoder->pix_fmt == AV_PIX_FMT_YUVJ420P ? AV_PIX_FMT_YUV420P : encoder->pix_fmt;
+    converter = sws_getContext(options.width_px, options.height_px, AV_PIX_FMT_BGR24,
+                               options.width_px, options.height_px, convert_to,
+                               SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr, nullptr);
+    if (converter == nullptr) {
+      return UnsupportedError(Where() + ": no colour conversion from BGR to " +
+                              av_get_pix_fmt_name(convert_to));
+    }
+    if (options.codec != VideoCodec::kFfv1) {
+      const int full_range = options.codec == VideoCodec::kMjpeg ? 1 : 0;
+      const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
+      sws_setColorspaceDetails(converter, bt601, 1, bt601, full_range, 0, 1 << 16, 1 << 16);
+    }
+    return Status::Ok();
+  }
 };
 
 VideoWriter::VideoWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -193,113 +320,11 @@ Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::filesystem::pa
   impl->partial_path = PartialPath(path);
   impl->options = options;
   const CodecChoice choice = ChoiceFor(options.codec);
-
-  // encoder
-  const AVCodec* codec = avcodec_find_encoder_by_name(choice.encoder);
-  if (codec == nullptr) {
-    return UnsupportedError(DisplayPath(path) + ": this FFmpeg has no " + choice.encoder +
-                            " encoder");
-  }
-  const int created = avformat_alloc_output_context2(&impl->format, nullptr, choice.muxer,
-                                                     impl->partial_path.c_str());
-  if (created < 0 || impl->format == nullptr) {
-    return UnsupportedError(DisplayPath(path) + ": this FFmpeg has no " + choice.muxer +
-                            " muxer: " + AvErrorText(created));
-  }
-  AVCodecContext* encoder = impl->encoder = avcodec_alloc_context3(codec);
-  impl->frame = av_frame_alloc();
-  impl->packet = av_packet_alloc();
-  if (encoder == nullptr || impl->frame == nullptr || impl->packet == nullptr) {
-    return IoError(DisplayPath(path) + ": out of memory");
-  }
-  encoder->width = options.width_px;
-  encoder->height = options.height_px;
-  encoder->pix_fmt = choice.pixel_format;
-  encoder->time_base = ContainerTimeBase(options);
-  encoder->framerate = av_d2q(options.nominal_fps, 1'000'000);
-  encoder->gop_size = std::max(1, static_cast<int>(std::lround(options.nominal_fps)));
-  encoder->sample_aspect_ratio = {1, 1};
-  // bit-exact: no random segment id, no version strings; the same frames give the same bytes
-  impl->format->flags |= AVFMT_FLAG_BITEXACT;
-  encoder->flags |= AV_CODEC_FLAG_BITEXACT;
-  if ((impl->format->oformat->flags & AVFMT_GLOBALHEADER) != 0) {
-    encoder->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  }
-  switch (options.codec) {
-    case VideoCodec::kH264:
-      // b-adapt=0: every run of non-key frames uses both B-frames, whatever the content
-      encoder->max_b_frames = 2;
-      encoder->thread_count = 2;  // fixed, so the bytes do not depend on the machine
-      av_opt_set(encoder->priv_data, "preset", "veryfast", 0);
-      av_opt_set(encoder->priv_data, "crf", std::to_string(options.quality).c_str(), 0);
-      av_opt_set(encoder->priv_data, "x264-params", "b-adapt=0", 0);
-      break;
-    case VideoCodec::kMjpeg:
-      encoder->color_range = AVCOL_RANGE_JPEG;
-      encoder->flags |= AV_CODEC_FLAG_QSCALE;
-      encoder->global_quality = FF_QP2LAMBDA * options.quality;
-      break;
-    case VideoCodec::kFfv1:
-      // version 3 with 4 slices encodes the slices in parallel; slices, not threads,
-      // decide the bytes, so the output stays the same on any machine
-      encoder->thread_count = 2;
-      encoder->thread_type = FF_THREAD_SLICE;
-      av_opt_set_int(encoder->priv_data, "slices", 4, 0);
-      av_opt_set_int(encoder->priv_data, "slicecrc", 1, 0);
-      encoder->level = 3;
-      break;
-  }
-  if (const int opened = avcodec_open2(encoder, codec, nullptr); opened < 0) {
-    return UnsupportedError(DisplayPath(path) + ": cannot open the " + choice.encoder +
-                            " encoder: " + AvErrorText(opened));
-  }
-
-  // stream and file
-  impl->stream = avformat_new_stream(impl->format, nullptr);
-  if (impl->stream == nullptr) return IoError(DisplayPath(path) + ": out of memory");
-  avcodec_parameters_from_context(impl->stream->codecpar, encoder);
-  impl->stream->time_base = encoder->time_base;
-  impl->stream->avg_frame_rate = encoder->framerate;
-  if (const Status folder = CreateParentFolder(path); !folder.ok()) {
-    return IoError(DisplayPath(path) + ": cannot create the file: " + folder.message());
-  }
-  if (const int opened = avio_open(&impl->format->pb, impl->partial_path.c_str(), AVIO_FLAG_WRITE);
-      opened < 0) {
-    return IoError(DisplayPath(path) + ": cannot create the file: " + AvErrorText(opened));
-  }
-  impl->created = true;
-  AVDictionary* muxer_options = nullptr;
-  if (options.codec == VideoCodec::kH264) av_dict_set(&muxer_options, "movflags", "+faststart", 0);
-  const int header = avformat_write_header(impl->format, &muxer_options);
-  av_dict_free(&muxer_options);
-  if (header < 0) {
-    return IoError(DisplayPath(path) + ": cannot write the header: " + AvErrorText(header));
-  }
-  // the muxer may have changed the stream's time base; packets are rescaled to it
-  // and StoredPtsNs() follows both roundings
-
-  // frame buffer and colour conversion
-  impl->frame->format = encoder->pix_fmt;
-  impl->frame->width = encoder->width;
-  impl->frame->height = encoder->height;
-  if (const int allocated = av_frame_get_buffer(impl->frame, 0); allocated < 0) {
-    return IoError(DisplayPath(path) + ": cannot allocate a frame: " + AvErrorText(allocated));
-  }
-  // yuvj420p is yuv420p at full range; naming it that way keeps swscale from warning
-  const AVPixelFormat convert_to =
-      encoder->pix_fmt == AV_PIX_FMT_YUVJ420P ? AV_PIX_FMT_YUV420P : encoder->pix_fmt;
-  impl->converter = sws_getContext(options.width_px, options.height_px, AV_PIX_FMT_BGR24,
-                                   options.width_px, options.height_px, convert_to,
-                                   SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr, nullptr);
-  if (impl->converter == nullptr) {
-    return UnsupportedError(DisplayPath(path) + ": no colour conversion from BGR to " +
-                            av_get_pix_fmt_name(convert_to));
-  }
-  if (options.codec != VideoCodec::kFfv1) {
-    const int full_range = options.codec == VideoCodec::kMjpeg ? 1 : 0;
-    const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
-    sws_setColorspaceDetails(impl->converter, bt601, 1, bt601, full_range, 0, 1 << 16, 1 << 16);
-  }
+  const AVCodec* codec = nullptr;
+  LIFTOFF_RETURN_IF_ERROR(impl->AllocateContexts(choice, codec));
+  LIFTOFF_RETURN_IF_ERROR(impl->OpenEncoder(codec, choice));
+  LIFTOFF_RETURN_IF_ERROR(impl->OpenFile());
+  LIFTOFF_RETURN_IF_ERROR(impl->PrepareConversion());
   return std::unique_ptr<VideoWriter>(new VideoWriter(std::move(impl)));
 }
 
