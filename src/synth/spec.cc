@@ -361,116 +361,130 @@ Status TrialSpec::Validate() const {
   return check.status();
 }
 
+namespace {
+
+// The sections of a trial spec's JSON, each into its struct; a missing key keeps the
+// default, a bad one is reported through the reader.
+
+// the seed is unsigned 64-bit, beyond what JsonReader's integers hold
+void ReadSeed(JsonReader& root, uint64_t& out) {
+  const json* seed = root.Raw("seed");
+  if (seed == nullptr || seed->is_null()) return;
+  if (seed->is_number_unsigned()) {
+    out = seed->get<uint64_t>();
+  } else if (seed->is_number_integer() && seed->get<int64_t>() >= 0) {
+    out = static_cast<uint64_t>(seed->get<int64_t>());
+  } else {
+    root.Fail("seed", "expected an integer in [0, 2^64), got " + seed->dump());
+  }
+}
+
+void ReadCamera(JsonReader& camera, CameraSpec& out) {
+  Read(camera, "width_px", out.width_px);
+  Read(camera, "height_px", out.height_px);
+  Read(camera, "fps", out.fps);
+  Read(camera, "exposure_s", out.exposure_s);
+  Read(camera, "drop_probability", out.drop_probability);
+  Read(camera, "timestamp_jitter_s", out.timestamp_jitter_s);
+  if (auto codec = camera.OptionalEnum("codec", {"h264", "mjpeg", "ffv1"})) {
+    out.codec = static_cast<VideoCodec>(*codec);
+  }
+  Read(camera, "quality", out.quality);
+}
+
+void ReadNuisance(JsonReader& nuisance, NuisanceSpec& out) {
+  Read(nuisance, "noise_sigma", out.noise_sigma);
+  Read(nuisance, "motion_blur_samples", out.motion_blur_samples);
+  Read(nuisance, "flicker_amplitude", out.flicker_amplitude);
+  Read(nuisance, "flicker_hz", out.flicker_hz);
+  Read(nuisance, "shake_px", out.shake_px);
+  Read(nuisance, "shadow", out.shadow);
+}
+
+void ReadLed(JsonReader& led, LedSpec& out) {
+  Read(led, "x_frac", out.x_frac);
+  Read(led, "y_frac", out.y_frac);
+  Read(led, "radius_px", out.radius_px);
+  if (auto bgr = led.OptionalNumberArray("color_bgr", 3)) {
+    for (size_t i = 0; i < 3; ++i) {
+      if ((*bgr)[i] != std::floor((*bgr)[i])) {
+        led.Fail("color_bgr", "expected 3 integers (blue, green, red), got " +
+                                  FormatNumber((*bgr)[i]) + " at index " + std::to_string(i));
+      }
+    }
+    // out-of-range values are left to the range check, which names the element
+    const auto channel = [](double value) {
+      return static_cast<int>(std::clamp(value, -1e6, 1e6));
+    };
+    out.blue = channel((*bgr)[0]);
+    out.green = channel((*bgr)[1]);
+    out.red = channel((*bgr)[2]);
+  }
+  Read(led, "intensity", out.intensity);
+  Read(led, "bloom", out.bloom);
+  Read(led, "on_video_s", out.on_video_s);
+}
+
+// a CSV curve's path is relative to the spec's folder
+void ReadHeightCurve(JsonReader& height, const fs::path& base_dir, HeightCurveSpec& curve) {
+  if (auto kind = height.OptionalEnum("kind", {"parametric", "csv"})) {
+    curve.kind = *kind == 0 ? "parametric" : "csv";
+  }
+  Read(height, "liftoff_rad", curve.liftoff_rad);
+  Read(height, "gain_m", curve.gain_m);
+  Read(height, "exponent", curve.exponent);
+  if (auto csv = height.OptionalString("csv")) {
+    if (csv->empty()) {
+      height.Fail("csv", "expected a non-empty path");
+    } else {
+      curve.csv_path = (base_dir / fs::path(*csv)).lexically_normal();
+    }
+  }
+}
+
+void ReadMotion(JsonReader& motion, const fs::path& base_dir, MotionSpec& out) {
+  if (auto foot = motion.OptionalEnum("foot", {"A", "B", "C", "D"})) {
+    out.foot = static_cast<Foot>(*foot);
+  }
+  if (auto rotation = motion.OptionalEnum("rotation", {"+", "-"})) {
+    out.rotation = *rotation == 0 ? RotationSense::kPositive : RotationSense::kNegative;
+  }
+  if (auto height = motion.OptionalObject("height")) ReadHeightCurve(*height, base_dir, out.height);
+  Read(motion, "bend_start_s", out.bend_start_s);
+  Read(motion, "bend_end_s", out.bend_end_s);
+  Read(motion, "ramp_start_s", out.ramp_start_s);
+  Read(motion, "ramp_rate_rad_per_s", out.ramp_rate_rad_per_s);
+  Read(motion, "diagonal_lag_rad", out.diagonal_lag_rad);
+}
+
+void ReadLog(JsonReader& log, LogSpec& out) {
+  Read(log, "led_on_device_ns", out.led_on_device_ns);
+  Read(log, "clock_drift_ppm", out.clock_drift_ppm);
+  Read(log, "rate_hz", out.rate_hz);
+  Read(log, "jitter_s", out.jitter_s);
+  Read(log, "burst_period_s", out.burst_period_s);
+  Read(log, "burst_length_s", out.burst_length_s);
+  Read(log, "led_event", out.led_event);
+  Read(log, "lead_s", out.lead_s);
+  Read(log, "tail_s", out.tail_s);
+}
+
+}  // namespace
+
 Result<TrialSpec> TrialSpecFromJson(const json& document, const std::string& source,
                                     const fs::path& base_dir) {
   TrialSpec spec;
   JsonReader root(document, source);
 
-  // the trial; the seed is unsigned 64-bit, beyond what JsonReader's integers hold
+  // the trial, then its sections
   Read(root, "id", spec.id);
-  if (const json* seed = root.Raw("seed"); seed != nullptr && !seed->is_null()) {
-    if (seed->is_number_unsigned()) {
-      spec.seed = seed->get<uint64_t>();
-    } else if (seed->is_number_integer() && seed->get<int64_t>() >= 0) {
-      spec.seed = static_cast<uint64_t>(seed->get<int64_t>());
-    } else {
-      root.Fail("seed", "expected an integer in [0, 2^64), got " + seed->dump());
-    }
-  }
+  ReadSeed(root, spec.seed);
   Read(root, "duration_s", spec.duration_s);
-
-  if (auto camera = root.OptionalObject("camera")) {
-    CameraSpec& out = spec.camera;
-    Read(*camera, "width_px", out.width_px);
-    Read(*camera, "height_px", out.height_px);
-    Read(*camera, "fps", out.fps);
-    Read(*camera, "exposure_s", out.exposure_s);
-    Read(*camera, "drop_probability", out.drop_probability);
-    Read(*camera, "timestamp_jitter_s", out.timestamp_jitter_s);
-    if (auto codec = camera->OptionalEnum("codec", {"h264", "mjpeg", "ffv1"})) {
-      out.codec = static_cast<VideoCodec>(*codec);
-    }
-    Read(*camera, "quality", out.quality);
-  }
-
-  if (auto nuisance = root.OptionalObject("nuisance")) {
-    NuisanceSpec& out = spec.nuisance;
-    Read(*nuisance, "noise_sigma", out.noise_sigma);
-    Read(*nuisance, "motion_blur_samples", out.motion_blur_samples);
-    Read(*nuisance, "flicker_amplitude", out.flicker_amplitude);
-    Read(*nuisance, "flicker_hz", out.flicker_hz);
-    Read(*nuisance, "shake_px", out.shake_px);
-    Read(*nuisance, "shadow", out.shadow);
-  }
-
-  if (auto led = root.OptionalObject("led")) {
-    LedSpec& out = spec.led;
-    Read(*led, "x_frac", out.x_frac);
-    Read(*led, "y_frac", out.y_frac);
-    Read(*led, "radius_px", out.radius_px);
-    if (auto bgr = led->OptionalNumberArray("color_bgr", 3)) {
-      for (size_t i = 0; i < 3; ++i) {
-        if ((*bgr)[i] != std::floor((*bgr)[i])) {
-          led->Fail("color_bgr", "expected 3 integers (blue, green, red), got " +
-                                     FormatNumber((*bgr)[i]) + " at index " + std::to_string(i));
-        }
-      }
-      // out-of-range values are left to the range check, which names the element
-      const auto channel = [](double value) {
-        return static_cast<int>(std::clamp(value, -1e6, 1e6));
-      };
-      out.blue = channel((*bgr)[0]);
-      out.green = channel((*bgr)[1]);
-      out.red = channel((*bgr)[2]);
-    }
-    Read(*led, "intensity", out.intensity);
-    Read(*led, "bloom", out.bloom);
-    Read(*led, "on_video_s", out.on_video_s);
-  }
-
-  if (auto motion = root.OptionalObject("motion")) {
-    MotionSpec& out = spec.motion;
-    if (auto foot = motion->OptionalEnum("foot", {"A", "B", "C", "D"})) {
-      out.foot = static_cast<Foot>(*foot);
-    }
-    if (auto rotation = motion->OptionalEnum("rotation", {"+", "-"})) {
-      out.rotation = *rotation == 0 ? RotationSense::kPositive : RotationSense::kNegative;
-    }
-    if (auto height = motion->OptionalObject("height")) {
-      HeightCurveSpec& curve = out.height;
-      if (auto kind = height->OptionalEnum("kind", {"parametric", "csv"})) {
-        curve.kind = *kind == 0 ? "parametric" : "csv";
-      }
-      Read(*height, "liftoff_rad", curve.liftoff_rad);
-      Read(*height, "gain_m", curve.gain_m);
-      Read(*height, "exponent", curve.exponent);
-      if (auto csv = height->OptionalString("csv")) {
-        if (csv->empty()) {
-          height->Fail("csv", "expected a non-empty path");
-        } else {
-          curve.csv_path = (base_dir / fs::path(*csv)).lexically_normal();
-        }
-      }
-    }
-    Read(*motion, "bend_start_s", out.bend_start_s);
-    Read(*motion, "bend_end_s", out.bend_end_s);
-    Read(*motion, "ramp_start_s", out.ramp_start_s);
-    Read(*motion, "ramp_rate_rad_per_s", out.ramp_rate_rad_per_s);
-    Read(*motion, "diagonal_lag_rad", out.diagonal_lag_rad);
-  }
-
-  if (auto log = root.OptionalObject("log")) {
-    LogSpec& out = spec.log;
-    Read(*log, "led_on_device_ns", out.led_on_device_ns);
-    Read(*log, "clock_drift_ppm", out.clock_drift_ppm);
-    Read(*log, "rate_hz", out.rate_hz);
-    Read(*log, "jitter_s", out.jitter_s);
-    Read(*log, "burst_period_s", out.burst_period_s);
-    Read(*log, "burst_length_s", out.burst_length_s);
-    Read(*log, "led_event", out.led_event);
-    Read(*log, "lead_s", out.lead_s);
-    Read(*log, "tail_s", out.tail_s);
-  }
+  if (auto camera = root.OptionalObject("camera")) ReadCamera(*camera, spec.camera);
+  if (auto nuisance = root.OptionalObject("nuisance")) ReadNuisance(*nuisance, spec.nuisance);
+  if (auto led = root.OptionalObject("led")) ReadLed(*led, spec.led);
+  if (auto motion = root.OptionalObject("motion")) ReadMotion(*motion, base_dir, spec.motion);
+  if (auto log = root.OptionalObject("log")) ReadLog(*log, spec.log);
   LIFTOFF_RETURN_IF_ERROR(root.Finish());
 
   // values: the same checks as Validate(), named by JSON pointer
