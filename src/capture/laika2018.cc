@@ -240,18 +240,12 @@ Result<ControllerLog> ImportLaika2018Log(const fs::path& path, const Calibration
   return log;
 }
 
-Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
-                                                    const fs::path& manifest_path) {
-  std::error_code error;
-  if (!fs::is_directory(folder, error)) return NotFoundError(folder.string() + ": no such folder");
-  const fs::path folder_abs = fs::absolute(folder).lexically_normal();
-  const fs::path csv_path = folder / kLaika2018TimesCsv;
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(csv_path));
-  const std::string where = csv_path.string();
+namespace {
 
-  // three header lines: a title, a padding line, the column names
-  const std::vector<TextLine> lines = SplitLines(text);
-  constexpr size_t kHeaderLines = 3;
+// three header lines: a title, a padding line, the column names
+constexpr size_t kHeaderLines = 3;
+
+Status CheckTimesHeader(const std::vector<TextLine>& lines, const std::string& where) {
   if (lines.size() < kHeaderLines) {
     return ParseError(where + ": expected three header lines and then rows, got " +
                       Plural(static_cast<int64_t>(lines.size()), "line"));
@@ -264,12 +258,20 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
     return ParseError(where + ":3: expected the column header `Foot,Test no,...`, got " +
                       Quote(column_header));
   }
+  return Status::Ok();
+}
 
-  // rows, skipping blank and comma-only padding lines
+// The times CSV's rows, and the finest digit printed in each time column.
+struct TimesRows {
   std::vector<CsvRow> rows;
-  std::map<std::string, int64_t> line_of_id;
   int led_on_decimals = 0;
   int liftoff_decimals = 0;
+};
+
+// rows after the header, skipping blank and comma-only padding lines; one row per trial
+Result<TimesRows> ReadTimesRows(const std::vector<TextLine>& lines, const std::string& where) {
+  TimesRows table;
+  std::map<std::string, int64_t> line_of_id;
   for (size_t i = kHeaderLines; i < lines.size(); ++i) {
     const std::string_view content = Trim(lines[i].text);
     if (content.find_first_not_of(", \t") == std::string_view::npos) continue;
@@ -279,66 +281,60 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
       return ParseError(where + ":" + std::to_string(row.line) + ": a second row for " + id +
                         " (the first is at line " + std::to_string(it->second) + ")");
     }
-    led_on_decimals = std::max(led_on_decimals, DecimalsPrinted(row.led_on_text));
-    liftoff_decimals = std::max(liftoff_decimals, DecimalsPrinted(row.liftoff_text));
-    rows.push_back(std::move(row));
+    table.led_on_decimals = std::max(table.led_on_decimals, DecimalsPrinted(row.led_on_text));
+    table.liftoff_decimals = std::max(table.liftoff_decimals, DecimalsPrinted(row.liftoff_text));
+    table.rows.push_back(std::move(row));
   }
-  if (rows.empty()) return ParseError(where + ": no rows after the three header lines");
+  if (table.rows.empty()) return ParseError(where + ": no rows after the three header lines");
+  return table;
+}
 
-  Laika2018FolderImport result;
-  TrialManifest& manifest = result.manifest;
-  manifest.base_dir = fs::absolute(manifest_path).lexically_normal().parent_path();
-  manifest.description =
-      "2018 Laika hardware tests (IROS 2018), imported from " + folder_abs.string();
-
-  // a spreadsheet drops trailing zeros ("10" for 10.00), so a column's resolution is the
-  // finest digit printed anywhere in it
-  const int64_t led_on_uncertainty_ns = HalfUnitNs(led_on_decimals) + kVideoFrameNs;
-  const int64_t liftoff_uncertainty_ns = HalfUnitNs(liftoff_decimals) + kVideoFrameNs;
-  std::set<std::string> used_logs;
-  for (const CsvRow& row : rows) {
-    TrialRecord& trial = manifest.trials.emplace_back();
-    trial.id = std::string(FootName(row.foot)) + std::to_string(row.test_number);
-    trial.foot = row.foot;
-    trial.test_number = row.test_number;
-    // group and rotation from Table II by foot letter
-    const FootLiftingMotion entry = PaperTableTwoMotion(row.foot);
-    trial.pulled_group = entry.pulled_group;
-    trial.rotation = entry.rotation;
-    trial.notes = "pulled group " + std::string(CableGroupName(entry.pulled_group)) +
-                  " and rotation " + std::string(RotationSenseName(entry.rotation)) +
-                  " from the paper's Table II as printed, by foot letter (A: HR +, B: HR -, "
-                  "C: HL +, D: HL -); unverified, see docs/formats.md";
-    // the log, and whether it is there
-    const std::string log_name = LogFileName(row.foot, row.test_number);
-    used_logs.insert(log_name);
-    trial.log_path = folder_abs / log_name;
-    trial.log_format = LogFormat::kLaika2018;
-    if (!fs::is_regular_file(trial.log_path, error)) {
-      result.warnings.push_back(trial.id + ": log \"" + log_name + "\" is missing (" + where + ":" +
-                                std::to_string(row.line) + ")");
-    }
-    // hand-measured times
-    EventTimes times;
-    times.led_on_ns = row.led_on_ns;
-    times.liftoff_ns = row.liftoff_ns;
-    times.led_on_uncertainty_ns = led_on_uncertainty_ns;
-    times.liftoff_uncertainty_ns = liftoff_uncertainty_ns;
-    times.source = "hand (2018 video, by eye)";
-    trial.times = times;
-    // the difference column, checked against the two times
-    if (row.difference_ns) {
-      const int64_t computed_ns = row.liftoff_ns - row.led_on_ns;
-      if (std::llabs(*row.difference_ns - computed_ns) > kDifferenceToleranceNs) {
-        result.warnings.push_back(trial.id + ": difference column says " +
-                                  FormatSeconds(*row.difference_ns, 3) +
-                                  " s but liftoff - LED-on = " + FormatSeconds(computed_ns, 3) +
-                                  " s (" + where + ":" + std::to_string(row.line) + ")");
-      }
+// A row's trial: foot and test, Table II's motion, the log and the hand-measured times.
+// Warns of a missing log and of a difference column that disagrees with the times.
+TrialRecord TrialFromRow(const CsvRow& row, const fs::path& folder_abs, const EventTimes& times,
+                         const std::string& where, std::vector<std::string>& warnings) {
+  TrialRecord trial;
+  trial.id = std::string(FootName(row.foot)) + std::to_string(row.test_number);
+  trial.foot = row.foot;
+  trial.test_number = row.test_number;
+  // group and rotation from Table II by foot letter
+  const FootLiftingMotion entry = PaperTableTwoMotion(row.foot);
+  trial.pulled_group = entry.pulled_group;
+  trial.rotation = entry.rotation;
+  trial.notes = "pulled group " + std::string(CableGroupName(entry.pulled_group)) +
+                " and rotation " + std::string(RotationSenseName(entry.rotation)) +
+                " from the paper's Table II as printed, by foot letter (A: HR +, B: HR -, "
+                "C: HL +, D: HL -); unverified, see docs/formats.md";
+  // the log, and whether it is there
+  const std::string log_name = LogFileName(row.foot, row.test_number);
+  trial.log_path = folder_abs / log_name;
+  trial.log_format = LogFormat::kLaika2018;
+  std::error_code error;
+  if (!fs::is_regular_file(trial.log_path, error)) {
+    warnings.push_back(trial.id + ": log \"" + log_name + "\" is missing (" + where + ":" +
+                       std::to_string(row.line) + ")");
+  }
+  // hand-measured times
+  trial.times = times;
+  trial.times->led_on_ns = row.led_on_ns;
+  trial.times->liftoff_ns = row.liftoff_ns;
+  // the difference column, checked against the two times
+  if (row.difference_ns) {
+    const int64_t computed_ns = row.liftoff_ns - row.led_on_ns;
+    if (std::llabs(*row.difference_ns - computed_ns) > kDifferenceToleranceNs) {
+      warnings.push_back(trial.id + ": difference column says " +
+                         FormatSeconds(*row.difference_ns, 3) +
+                         " s but liftoff - LED-on = " + FormatSeconds(computed_ns, 3) + " s (" +
+                         where + ":" + std::to_string(row.line) + ")");
     }
   }
+  return trial;
+}
 
-  // logs that no row names, in name order
+// logs in `folder` that no row names, in name order
+void WarnUnusedLogs(const fs::path& folder, const std::set<std::string>& used_logs,
+                    const std::string& where, std::vector<std::string>& warnings) {
+  std::error_code error;
   std::set<std::string> unused_logs;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
@@ -348,8 +344,46 @@ Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
     }
   }
   for (const std::string& name : unused_logs) {
-    result.warnings.push_back("log \"" + name + "\" has no row in " + where);
+    warnings.push_back("log \"" + name + "\" has no row in " + where);
   }
+}
+
+}  // namespace
+
+Result<Laika2018FolderImport> ImportLaika2018Folder(const fs::path& folder,
+                                                    const fs::path& manifest_path) {
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return NotFoundError(folder.string() + ": no such folder");
+  const fs::path folder_abs = fs::absolute(folder).lexically_normal();
+  const fs::path csv_path = folder / kLaika2018TimesCsv;
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string text, ReadWholeFile(csv_path));
+  const std::string where = csv_path.string();
+
+  // the times CSV: header, then rows
+  const std::vector<TextLine> lines = SplitLines(text);
+  LIFTOFF_RETURN_IF_ERROR(CheckTimesHeader(lines, where));
+  LIFTOFF_ASSIGN_OR_RETURN(const TimesRows table, ReadTimesRows(lines, where));
+
+  Laika2018FolderImport result;
+  TrialManifest& manifest = result.manifest;
+  manifest.base_dir = fs::absolute(manifest_path).lexically_normal().parent_path();
+  manifest.description =
+      "2018 Laika hardware tests (IROS 2018), imported from " + folder_abs.string();
+
+  // a spreadsheet drops trailing zeros ("10" for 10.00), so a column's resolution is the
+  // finest digit printed anywhere in it
+  EventTimes times;
+  times.led_on_uncertainty_ns = HalfUnitNs(table.led_on_decimals) + kVideoFrameNs;
+  times.liftoff_uncertainty_ns = HalfUnitNs(table.liftoff_decimals) + kVideoFrameNs;
+  times.source = "hand (2018 video, by eye)";
+
+  // a trial a row, then the logs no row names
+  std::set<std::string> used_logs;
+  for (const CsvRow& row : table.rows) {
+    manifest.trials.push_back(TrialFromRow(row, folder_abs, times, where, result.warnings));
+    used_logs.insert(LogFileName(row.foot, row.test_number));
+  }
+  WarnUnusedLogs(folder, used_logs, where, result.warnings);
 
   LIFTOFF_RETURN_IF_ERROR(manifest.Validate());
   return result;
