@@ -485,6 +485,43 @@ std::string EmulatorStats::Brief() const {
 // ---------------------------------------------------------------------------------------
 // Emulator
 
+namespace {
+
+// When a run's scripted events fall, ns since the run's start (-1: never).
+struct RunSchedule {
+  int64_t duration_ns = 0;  // 0: no limit
+  int64_t stall_at_ns = -1;
+  int64_t stall_end_ns = -1;
+  int64_t disconnect_at_ns = -1;
+  int64_t reconnect_at_ns = -1;
+  // sample k leaves at device time k * period, i.e. host time k * period / (1 + drift)
+  double host_period_ns = 0;
+
+  int64_t HostDueNs(int64_t k) const {
+    return std::llround(static_cast<double>(k) * host_period_ns);
+  }
+  bool Stalled(int64_t now_ns) const {
+    return stall_at_ns >= 0 && now_ns >= stall_at_ns && now_ns < stall_end_ns;
+  }
+};
+
+// What a run has done so far.
+struct RunProgress {
+  int64_t next_sample = 0;
+  bool stall_counted = false;
+  bool disconnect_done = false;
+};
+
+void SleepUntil(int64_t monotonic_ns) {
+  timespec deadline{};
+  deadline.tv_sec = static_cast<time_t>(monotonic_ns / kNanosecondsPerSecond);
+  deadline.tv_nsec = static_cast<long>(monotonic_ns % kNanosecondsPerSecond);
+  while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+  }
+}
+
+}  // namespace
+
 struct Emulator::Impl {
   explicit Impl(const EmulatorOptions& emulator_options)
       : options(emulator_options), model(emulator_options.model), random(emulator_options.seed) {}
@@ -503,6 +540,14 @@ struct Emulator::Impl {
   // Writes what the pty takes now, without waiting.
   Status Flush();
   void Disconnect();
+  // one turn of Run's loop, in order
+  RunSchedule Schedule() const;
+  Status FollowLinkScript(int64_t now_ns, const RunSchedule& schedule, RunProgress& progress);
+  bool CountStall(int64_t now_ns, const RunSchedule& schedule, RunProgress& progress);
+  void MakeDueSamples(int64_t now_ns, const RunSchedule& schedule, RunProgress& progress);
+  void Wait(int64_t start_ns, bool linked, const RunSchedule& schedule,
+            const RunProgress& progress);
+  Status Drain(const std::atomic<bool>& stop);
   size_t queued_bytes() const { return out.size() - out_head; }
   bool test_over() const {
     return options.exit_after_test && model.test_end_ns() &&
@@ -740,65 +785,110 @@ Result<std::unique_ptr<Emulator>> Emulator::Create(const EmulatorOptions& option
   return emulator;
 }
 
+RunSchedule Emulator::Impl::Schedule() const {
+  const EmulatorOptions& o = options;
+  RunSchedule schedule;
+  schedule.duration_ns = NsFromSeconds(o.duration_s);
+  schedule.stall_at_ns = o.stall_at_s >= 0 ? NsFromSeconds(o.stall_at_s) : -1;
+  schedule.stall_end_ns = schedule.stall_at_ns + NsFromSeconds(o.stall_for_s);
+  schedule.disconnect_at_ns = o.disconnect_at_s >= 0 ? NsFromSeconds(o.disconnect_at_s) : -1;
+  schedule.reconnect_at_ns = schedule.disconnect_at_ns + NsFromSeconds(o.disconnect_for_s);
+  schedule.host_period_ns = sample_period_ns / device_per_host;
+  return schedule;
+}
+
+// the port goes away, and comes back as a new pty
+Status Emulator::Impl::FollowLinkScript(int64_t now_ns, const RunSchedule& schedule,
+                                        RunProgress& progress) {
+  if (schedule.disconnect_at_ns >= 0 && !progress.disconnect_done && !disconnected &&
+      now_ns >= schedule.disconnect_at_ns) {
+    Disconnect();
+  }
+  if (disconnected && now_ns >= schedule.reconnect_at_ns) {
+    LIFTOFF_RETURN_IF_ERROR(OpenPty().WithContext("reconnecting after the disconnect"));
+    disconnected = false;
+    progress.disconnect_done = true;
+    model.EmitHeader();
+  }
+  return Status::Ok();
+}
+
+// whether the link is stalled now; the stall is counted once
+bool Emulator::Impl::CountStall(int64_t now_ns, const RunSchedule& schedule,
+                                RunProgress& progress) {
+  const bool stalled = schedule.Stalled(now_ns);
+  if (stalled && !progress.stall_counted) {
+    progress.stall_counted = true;
+    std::lock_guard<std::mutex> lock(mutex);
+    ++stats.stalls;
+  }
+  return stalled;
+}
+
+// samples due by now (paced), or a batch while the reader keeps up (unpaced)
+void Emulator::Impl::MakeDueSamples(int64_t now_ns, const RunSchedule& schedule,
+                                    RunProgress& progress) {
+  if (options.unpaced) {
+    for (int i = 0; i < kUnpacedBatchFrames && queued_bytes() < kUnpacedQueueBytes; ++i) {
+      MakeSample(progress.next_sample++);
+    }
+  } else {
+    while (schedule.HostDueNs(progress.next_sample) <= now_ns && !test_over()) {
+      MakeSample(progress.next_sample++);
+    }
+  }
+}
+
+// wait: for the next sample (paced), or for the reader to take bytes (unpaced)
+void Emulator::Impl::Wait(int64_t start_ns, bool linked, const RunSchedule& schedule,
+                          const RunProgress& progress) {
+  const int64_t now_ns = MonotonicNowNs() - start_ns;
+  if (options.unpaced && linked && queued_bytes() >= kUnpacedQueueBytes) {
+    pollfd fd{pty->master_fd(), POLLOUT, 0};
+    ::poll(&fd, 1, 10);
+  } else if (options.unpaced && !linked) {
+    SleepUntil(start_ns + now_ns + kNanosecondsPerMillisecond);
+  } else if (!options.unpaced) {
+    int64_t wake_ns = std::min(schedule.HostDueNs(progress.next_sample), now_ns + kMaxSleepNs);
+    // a reader behind on its bytes gets another try soon
+    if (linked && queued_bytes() > 0)
+      wake_ns = std::min(wake_ns, now_ns + kNanosecondsPerMillisecond);
+    if (wake_ns > now_ns) SleepUntil(start_ns + wake_ns);
+  }
+}
+
+// a run that ended by itself gives its last frames time to reach the reader
+Status Emulator::Impl::Drain(const std::atomic<bool>& stop) {
+  const int64_t drain_end_ns = MonotonicNowNs() + kDrainNs;
+  while (queued_bytes() > 0 && MonotonicNowNs() < drain_end_ns &&
+         !stop.load(std::memory_order_relaxed)) {
+    LIFTOFF_RETURN_IF_ERROR(Flush());
+    if (queued_bytes() > 0) {
+      pollfd fd{pty->master_fd(), POLLOUT, 0};
+      ::poll(&fd, 1, 10);
+    }
+  }
+  return Status::Ok();
+}
+
 Status Emulator::Run(const std::atomic<bool>& stop) {
   Impl& s = *impl_;
-  const EmulatorOptions& o = s.options;
-  const auto sleep_until = [](int64_t monotonic_ns) {
-    timespec deadline{};
-    deadline.tv_sec = static_cast<time_t>(monotonic_ns / kNanosecondsPerSecond);
-    deadline.tv_nsec = static_cast<long>(monotonic_ns % kNanosecondsPerSecond);
-    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
-    }
-  };
+  const RunSchedule schedule = s.Schedule();
   const int64_t start_ns = MonotonicNowNs();
-  const int64_t duration_ns = NsFromSeconds(o.duration_s);
-  const int64_t stall_at_ns = o.stall_at_s >= 0 ? NsFromSeconds(o.stall_at_s) : -1;
-  const int64_t stall_end_ns = stall_at_ns + NsFromSeconds(o.stall_for_s);
-  const int64_t disconnect_at_ns = o.disconnect_at_s >= 0 ? NsFromSeconds(o.disconnect_at_s) : -1;
-  const int64_t reconnect_at_ns = disconnect_at_ns + NsFromSeconds(o.disconnect_for_s);
-  // sample k leaves at device time k * period, i.e. host time k * period / (1 + drift)
-  const double host_period_ns = s.sample_period_ns / s.device_per_host;
-  const auto host_due_ns = [&](int64_t k) -> int64_t {
-    return std::llround(static_cast<double>(k) * host_period_ns);
-  };
-  int64_t next_sample = 0;
-  bool stall_counted = false;
-  bool disconnect_done = false;
+  RunProgress progress;
   bool finished = false;  // the run's end came by itself (not `stop`)
 
   while (!stop.load(std::memory_order_relaxed)) {
-    int64_t now_ns = MonotonicNowNs() - start_ns;
-    if (duration_ns > 0 && now_ns >= duration_ns) {
+    const int64_t now_ns = MonotonicNowNs() - start_ns;
+    if (schedule.duration_ns > 0 && now_ns >= schedule.duration_ns) {
       finished = true;
       break;
     }
-    // the port goes away, and comes back as a new pty
-    if (disconnect_at_ns >= 0 && !disconnect_done && !s.disconnected &&
-        now_ns >= disconnect_at_ns) {
-      s.Disconnect();
-    }
-    if (s.disconnected && now_ns >= reconnect_at_ns) {
-      LIFTOFF_RETURN_IF_ERROR(s.OpenPty().WithContext("reconnecting after the disconnect"));
-      s.disconnected = false;
-      disconnect_done = true;
-      s.model.EmitHeader();
-    }
-    const bool stalled = stall_at_ns >= 0 && now_ns >= stall_at_ns && now_ns < stall_end_ns;
-    if (stalled && !stall_counted) {
-      stall_counted = true;
-      std::lock_guard<std::mutex> lock(s.mutex);
-      ++s.stats.stalls;
-    }
+    // the link as scripted, the samples due, then the host's side
+    LIFTOFF_RETURN_IF_ERROR(s.FollowLinkScript(now_ns, schedule, progress));
+    const bool stalled = s.CountStall(now_ns, schedule, progress);
     const bool linked = !s.disconnected && !stalled;
-
-    // samples due by now (paced), or a batch while the reader keeps up (unpaced)
-    if (o.unpaced) {
-      for (int i = 0; i < kUnpacedBatchFrames && s.queued_bytes() < kUnpacedQueueBytes; ++i) {
-        s.MakeSample(next_sample++);
-      }
-    } else {
-      while (host_due_ns(next_sample) <= now_ns && !s.test_over()) s.MakeSample(next_sample++);
-    }
+    s.MakeDueSamples(now_ns, schedule, progress);
     // frames made before the host's commands: the model is never ahead of its present
     if (linked) {
       const int64_t device_now_ns = std::llround(static_cast<double>(now_ns) * s.device_per_host);
@@ -809,35 +899,9 @@ Status Emulator::Run(const std::atomic<bool>& stop) {
       finished = true;
       break;
     }
-
-    // wait: for the next sample (paced), or for the reader to take bytes (unpaced)
-    now_ns = MonotonicNowNs() - start_ns;
-    if (o.unpaced && linked && s.queued_bytes() >= kUnpacedQueueBytes) {
-      pollfd fd{s.pty->master_fd(), POLLOUT, 0};
-      ::poll(&fd, 1, 10);
-    } else if (o.unpaced && !linked) {
-      sleep_until(start_ns + now_ns + kNanosecondsPerMillisecond);
-    } else if (!o.unpaced) {
-      int64_t wake_ns = std::min(host_due_ns(next_sample), now_ns + kMaxSleepNs);
-      // a reader behind on its bytes gets another try soon
-      if (linked && s.queued_bytes() > 0)
-        wake_ns = std::min(wake_ns, now_ns + kNanosecondsPerMillisecond);
-      if (wake_ns > now_ns) sleep_until(start_ns + wake_ns);
-    }
+    s.Wait(start_ns, linked, schedule, progress);
   }
-
-  // a run that ended by itself gives its last frames time to reach the reader
-  if (finished && !s.disconnected) {
-    const int64_t drain_end_ns = MonotonicNowNs() + kDrainNs;
-    while (s.queued_bytes() > 0 && MonotonicNowNs() < drain_end_ns &&
-           !stop.load(std::memory_order_relaxed)) {
-      LIFTOFF_RETURN_IF_ERROR(s.Flush());
-      if (s.queued_bytes() > 0) {
-        pollfd fd{s.pty->master_fd(), POLLOUT, 0};
-        ::poll(&fd, 1, 10);
-      }
-    }
-  }
+  if (finished && !s.disconnected) LIFTOFF_RETURN_IF_ERROR(s.Drain(stop));
   return Status::Ok();
 }
 
