@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "liftoff/capture/journal.h"
 #include "liftoff/core/output.h"
@@ -169,44 +170,34 @@ bool StreamDecoder::IsRestart(uint32_t sequence, uint32_t device_time_us) const 
   return sequence_back && clock_back;
 }
 
+namespace {
+
+// a data frame's sequence number and device time; nullopt for a command echoed back
+std::optional<std::pair<uint32_t, uint32_t>> SequenceAndTime(const wire::Frame& frame) {
+  switch (frame.type) {
+    case wire::FrameType::kSample:
+      return std::pair{frame.sample.sequence, frame.sample.device_time_us};
+    case wire::FrameType::kHeader:
+      return std::pair{frame.header.sequence, frame.header.device_time_us};
+    case wire::FrameType::kEvent:
+      return std::pair{frame.event.sequence, frame.event.device_time_us};
+    case wire::FrameType::kCommand: return std::nullopt;  // our own commands: not data
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& rows) {
   const wire::Frame& frame = received.frame;
   const int64_t host_ns = received.host_time_ns;
-  uint32_t sequence = 0;
-  uint32_t device_time_us = 0;
-  switch (frame.type) {
-    case wire::FrameType::kSample:
-      sequence = frame.sample.sequence;
-      device_time_us = frame.sample.device_time_us;
-      break;
-    case wire::FrameType::kHeader:
-      sequence = frame.header.sequence;
-      device_time_us = frame.header.device_time_us;
-      break;
-    case wire::FrameType::kEvent:
-      sequence = frame.event.sequence;
-      device_time_us = frame.event.device_time_us;
-      break;
-    case wire::FrameType::kCommand: return;  // our own commands echoed back: not data
-  }
+  const auto stamp = SequenceAndTime(frame);
+  if (!stamp) return;
+  const auto [sequence, device_time_us] = *stamp;
 
   // a controller restart (sequence and clock both start again) is recognised before the
-  // stale-frame filter below, which would otherwise drop everything after it: the device
-  // clock is rebased so the log's time continues just after its last row
-  std::optional<std::string> restart;
-  if (IsRestart(sequence, device_time_us)) {
-    ++counters_.restarts;
-    restart = "controller restarted: sequence " + std::to_string(*sequence_.last()) + " -> " +
-              std::to_string(sequence) + ", device clock " +
-              FormatFixed(static_cast<double>(*last_device_us_) * 1e-6, 3) + " s -> " +
-              FormatFixed(static_cast<double>(device_time_us) * 1e-6, 3) + " s";
-    clock_.Reset();
-    sequence_.Reset();
-    const int64_t continue_ns =
-        std::max(last_row_ns_.value_or(0), last_frame_ns_.value_or(0)) + kNanosecondsPerMicrosecond;
-    clock_offset_ns_ =
-        continue_ns - static_cast<int64_t>(device_time_us) * kNanosecondsPerMicrosecond;
-  }
+  // stale-frame filter below, which would otherwise drop everything after it
+  std::optional<std::string> restart = RebaseAfterRestart(sequence, device_time_us);
 
   // stale frames (device time not moving forward) are dropped before they touch the
   // sequence tracker, so a repeat after a reconnect does not fake a gap
@@ -218,7 +209,35 @@ void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& r
     return;
   }
 
-  // markers of what happened between the previous frame and this one, halfway between
+  EmitMarkers(sequence, device_ns, host_ns, std::move(restart), rows);
+  last_frame_ns_ = device_ns;
+  last_device_us_ = device_time_us;
+  EmitFrame(frame, device_ns, host_ns, rows);
+}
+
+// on a restart the device clock is rebased so the log's time continues just after its
+// last row
+std::optional<std::string> StreamDecoder::RebaseAfterRestart(uint32_t sequence,
+                                                             uint32_t device_time_us) {
+  if (!IsRestart(sequence, device_time_us)) return std::nullopt;
+  ++counters_.restarts;
+  std::string restart = "controller restarted: sequence " + std::to_string(*sequence_.last()) +
+                        " -> " + std::to_string(sequence) + ", device clock " +
+                        FormatFixed(static_cast<double>(*last_device_us_) * 1e-6, 3) + " s -> " +
+                        FormatFixed(static_cast<double>(device_time_us) * 1e-6, 3) + " s";
+  clock_.Reset();
+  sequence_.Reset();
+  const int64_t continue_ns =
+      std::max(last_row_ns_.value_or(0), last_frame_ns_.value_or(0)) + kNanosecondsPerMicrosecond;
+  clock_offset_ns_ =
+      continue_ns - static_cast<int64_t>(device_time_us) * kNanosecondsPerMicrosecond;
+  return restart;
+}
+
+// markers of what happened between the previous frame and this one, halfway between:
+// a reconnect, a restart, a gap in the sequence
+void StreamDecoder::EmitMarkers(uint32_t sequence, int64_t device_ns, int64_t host_ns,
+                                std::optional<std::string> restart, std::vector<LogRow>& rows) {
   const int64_t marker_ns =
       std::max(last_frame_ns_ ? *last_frame_ns_ + (device_ns - *last_frame_ns_) / 2 : device_ns,
                last_row_ns_.value_or(device_ns));
@@ -239,10 +258,11 @@ void StreamDecoder::Accept(const ReceivedFrame& received, std::vector<LogRow>& r
     if (gap->missing > 1) detail += ".." + std::to_string(last_missing);
     Emit(LogEvent{marker_ns, host_ns, LogEventKind::kGap, std::move(detail)}, rows);
   }
-  last_frame_ns_ = device_ns;
-  last_device_us_ = device_time_us;
+}
 
-  // the frame itself
+// the frame itself: a sample, the device's header (kept once), an event
+void StreamDecoder::EmitFrame(const wire::Frame& frame, int64_t device_ns, int64_t host_ns,
+                              std::vector<LogRow>& rows) {
   switch (frame.type) {
     case wire::FrameType::kSample: {
       LogSample sample = SampleFromFrame(frame.sample, device_ns, host_ns, *calibration_);

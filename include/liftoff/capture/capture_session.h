@@ -92,6 +92,13 @@ class StreamDecoder {
  private:
   void Accept(const ReceivedFrame& received, std::vector<LogRow>& rows);
   bool IsRestart(uint32_t sequence, uint32_t device_time_us) const;
+  // steps of Accept: the clock rebased after a restart (returns the note to log), the
+  // markers of what happened since the previous frame, then the frame's own row
+  std::optional<std::string> RebaseAfterRestart(uint32_t sequence, uint32_t device_time_us);
+  void EmitMarkers(uint32_t sequence, int64_t device_ns, int64_t host_ns,
+                   std::optional<std::string> restart, std::vector<LogRow>& rows);
+  void EmitFrame(const wire::Frame& frame, int64_t device_ns, int64_t host_ns,
+                 std::vector<LogRow>& rows);
   void Emit(LogRow row, std::vector<LogRow>& rows);
 
   const Calibration* calibration_;
