@@ -138,6 +138,113 @@ double TimeToRise(const Coefficients& c, double threshold) {
   return std::numeric_limits<double>::infinity();
 }
 
+// The robust noise of a series from its successive differences (model-free), at least
+// kNoiseFloor times the threshold.
+double DifferenceNoise(const std::vector<double>& height, double threshold) {
+  std::vector<double> differences;
+  for (size_t i = 1; i < height.size(); ++i) {
+    differences.push_back(std::abs(height[i] - height[i - 1]));
+  }
+  return std::max(1.4826 * Median(differences) / std::sqrt(2.0), kNoiseFloor * threshold);
+}
+
+// Every knee tried, with its fit; `best` the least loss among the rising fits.
+struct KneeSearch {
+  std::vector<double> knees;
+  std::vector<double> losses;  // infinity for a fit that does not rise
+  std::vector<Coefficients> coefficients;
+  size_t best = 0;
+};
+
+// candidate knees: every sample time and the midpoints between them
+KneeSearch KneeGrid(const std::vector<double>& t_s) {
+  KneeSearch search;
+  for (size_t i = 0; i + 1 < t_s.size(); ++i) {
+    search.knees.push_back(t_s[i]);
+    search.knees.push_back(0.5 * (t_s[i] + t_s[i + 1]));
+  }
+  search.losses.resize(search.knees.size());
+  search.coefficients.resize(search.knees.size());
+  return search;
+}
+
+// Fits every knee at Huber scale `scale`; false when none gives a rising fit.
+bool FitEveryKnee(const std::vector<double>& t_s, const std::vector<double>& height,
+                  const std::vector<bool>& lag_free, double scale, const RiseFitOptions& options,
+                  KneeSearch& search) {
+  double best_loss = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < search.knees.size(); ++k) {
+    auto [c, loss] = FitAtKnee(t_s, height, lag_free, search.knees[k], scale, options);
+    search.coefficients[k] = c;
+    // rising: by the last sample, beyond what roundoff makes of a flat series (~1e-13)
+    const double rise = Evaluate(c, search.knees[k], t_s.back()) - c.level;
+    search.losses[k] =
+        rise > kLeastRise * options.threshold ? loss : std::numeric_limits<double>::infinity();
+    if (search.losses[k] < best_loss) {
+      best_loss = search.losses[k];
+      search.best = k;
+    }
+  }
+  return std::isfinite(best_loss);
+}
+
+// the samples' residuals from the best fit
+std::vector<double> BestResiduals(const std::vector<double>& t_s, const std::vector<double>& height,
+                                  const KneeSearch& search) {
+  std::vector<double> residuals(t_s.size());
+  for (size_t i = 0; i < t_s.size(); ++i) {
+    residuals[i] =
+        height[i] - Evaluate(search.coefficients[search.best], search.knees[search.best], t_s[i]);
+  }
+  return residuals;
+}
+
+// robust standard deviation: 1.4826 times the median absolute value
+double RobustSpread(const std::vector<double>& residuals) {
+  std::vector<double> absolute(residuals.size());
+  for (size_t i = 0; i < residuals.size(); ++i) absolute[i] = std::abs(residuals[i]);
+  return 1.4826 * Median(absolute);
+}
+
+// lag-one correlation of the residuals, clamped to [0, 0.95]
+double LagOneCorrelation(const std::vector<double>& residuals) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < residuals.size(); ++i) {
+    den += residuals[i] * residuals[i];
+    if (i > 0) num += residuals[i] * residuals[i - 1];
+  }
+  return den > 0 ? std::clamp(num / den, 0.0, 0.95) : 0.0;
+}
+
+// Every knee within a two-sigma loss increase of the best (noise inflated for correlated
+// residuals) widens fit's crossing and knee intervals; needs fit.noise and fit.correlation.
+void SetIntervals(const std::vector<double>& t_s, const std::vector<bool>& lag_free,
+                  const KneeSearch& search, const RiseFitOptions& options, RiseFit& fit) {
+  // (in the losses' unit: when every sample is lag-free, each weighs lag_free_weight)
+  const double inflation = (1 + fit.correlation) / (1 - fit.correlation);
+  const bool all_lag_free = std::find(lag_free.begin(), lag_free.end(), false) == lag_free.end();
+  const double unit = all_lag_free ? options.lag_free_weight : 1.0;
+  const double allowed = 4.0 * fit.noise * fit.noise * inflation * unit;
+  fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
+  fit.knee_low_s = fit.knee_high_s = fit.knee_s;
+  // the knee grid holds the samples and their midpoints: its step is half the samples'
+  // mean spacing, and a knee between two grid points is within a step of both; the bounds
+  // get two steps (one sample spacing) of margin
+  const size_t n = t_s.size();
+  const double grid_step = 0.5 * (t_s.back() - t_s.front()) / static_cast<double>(n - 1);
+  const std::vector<double>& knees = search.knees;
+  for (size_t k = 0; k < knees.size(); ++k) {
+    if (!(search.losses[k] - search.losses[search.best] <= allowed)) continue;
+    const double crossing = knees[k] + TimeToRise(search.coefficients[k], options.threshold);
+    if (!std::isfinite(crossing)) continue;
+    fit.crossing_low_s = std::min(fit.crossing_low_s, crossing - 2 * grid_step);
+    fit.crossing_high_s = std::max(fit.crossing_high_s, crossing + 2 * grid_step);
+    fit.knee_low_s = std::min(fit.knee_low_s, knees[k] - 2 * grid_step);
+    fit.knee_high_s = std::max(fit.knee_high_s, knees[k] + 2 * grid_step);
+  }
+  fit.crossing_middle_s = 0.5 * (fit.crossing_low_s + fit.crossing_high_s);
+}
+
 }  // namespace
 
 double RiseModel(const RiseFit& fit, double t_s) {
@@ -151,59 +258,20 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   if (n < 8 || height.size() != n || !(lag_free_in.empty() || lag_free_in.size() == n)) return fit;
   const std::vector<bool> lag_free = lag_free_in.empty() ? std::vector<bool>(n, true) : lag_free_in;
 
-  // noise first from successive differences (model-free), then from the best fit's residuals
-  std::vector<double> differences;
-  for (size_t i = 1; i < n; ++i) differences.push_back(std::abs(height[i] - height[i - 1]));
-  double noise = std::max(1.4826 * Median(differences) / std::sqrt(2.0), kNoiseFloor * options.threshold);
+  // two rounds over every knee: the noise first from successive differences, then from
+  // the first round's best fit; the second round's residuals give their correlation
+  double noise = DifferenceNoise(height, options.threshold);
+  KneeSearch search = KneeGrid(t_s);
+  if (!FitEveryKnee(t_s, height, lag_free, options.huber_k * noise, options, search)) return fit;
+  noise =
+      std::max(RobustSpread(BestResiduals(t_s, height, search)), kNoiseFloor * options.threshold);
+  if (!FitEveryKnee(t_s, height, lag_free, options.huber_k * noise, options, search)) return fit;
+  fit.correlation = LagOneCorrelation(BestResiduals(t_s, height, search));
 
-  // candidate knees: every sample time and the midpoints between them
-  std::vector<double> knees;
-  for (size_t i = 0; i + 1 < n; ++i) {
-    knees.push_back(t_s[i]);
-    knees.push_back(0.5 * (t_s[i] + t_s[i + 1]));
-  }
-  std::vector<double> losses(knees.size());
-  std::vector<Coefficients> coefficients(knees.size());
-  size_t best = 0;
-  for (int round = 0; round < 2; ++round) {
-    const double scale = options.huber_k * noise;
-    double best_loss = std::numeric_limits<double>::infinity();
-    for (size_t k = 0; k < knees.size(); ++k) {
-      auto [c, loss] = FitAtKnee(t_s, height, lag_free, knees[k], scale, options);
-      coefficients[k] = c;
-      // rising: by the last sample, beyond what roundoff makes of a flat series (~1e-13)
-      const double rise = Evaluate(c, knees[k], t_s.back()) - c.level;
-      losses[k] = rise > kLeastRise * options.threshold ? loss
-                                                       : std::numeric_limits<double>::infinity();
-      if (losses[k] < best_loss) {
-        best_loss = losses[k];
-        best = k;
-      }
-    }
-    if (!std::isfinite(best_loss)) return fit;
-    std::vector<double> residuals(n);
-    for (size_t i = 0; i < n; ++i) {
-      residuals[i] = height[i] - Evaluate(coefficients[best], knees[best], t_s[i]);
-    }
-    std::vector<double> absolute(n);
-    for (size_t i = 0; i < n; ++i) absolute[i] = std::abs(residuals[i]);
-    const double refined = 1.4826 * Median(absolute);
-    if (round == 0) {
-      noise = std::max(refined, kNoiseFloor * options.threshold);
-      continue;
-    }
-    // lag-one correlation of the residuals
-    double num = 0, den = 0;
-    for (size_t i = 0; i < n; ++i) {
-      den += residuals[i] * residuals[i];
-      if (i > 0) num += residuals[i] * residuals[i - 1];
-    }
-    fit.correlation = den > 0 ? std::clamp(num / den, 0.0, 0.95) : 0.0;
-  }
-
-  const Coefficients& c = coefficients[best];
+  // the best model, its crossing, then the intervals of the knees that fit about as well
+  const Coefficients& c = search.coefficients[search.best];
   fit.ok = true;
-  fit.knee_s = knees[best];
+  fit.knee_s = search.knees[search.best];
   fit.level = c.level;
   fit.slope = c.slope;
   fit.curvature = c.curvature;
@@ -211,29 +279,7 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   const double rise_time = TimeToRise(c, options.threshold);
   fit.crossing_s = fit.knee_s + rise_time;
   fit.rate_at_crossing = c.slope + 2 * c.curvature * rise_time;
-
-  // every knee within a two-sigma loss increase (noise inflated for correlated residuals)
-  // (in the losses' unit: when every sample is lag-free, each weighs lag_free_weight)
-  const double inflation = (1 + fit.correlation) / (1 - fit.correlation);
-  const bool all_lag_free = std::find(lag_free.begin(), lag_free.end(), false) == lag_free.end();
-  const double unit = all_lag_free ? options.lag_free_weight : 1.0;
-  const double allowed = 4.0 * noise * noise * inflation * unit;
-  fit.crossing_low_s = fit.crossing_high_s = fit.crossing_s;
-  fit.knee_low_s = fit.knee_high_s = fit.knee_s;
-  // the knee grid holds the samples and their midpoints: its step is half the samples'
-  // mean spacing, and a knee between two grid points is within a step of both; the bounds
-  // get two steps (one sample spacing) of margin
-  const double grid_step = 0.5 * (t_s.back() - t_s.front()) / static_cast<double>(n - 1);
-  for (size_t k = 0; k < knees.size(); ++k) {
-    if (!(losses[k] - losses[best] <= allowed)) continue;
-    const double crossing = knees[k] + TimeToRise(coefficients[k], options.threshold);
-    if (!std::isfinite(crossing)) continue;
-    fit.crossing_low_s = std::min(fit.crossing_low_s, crossing - 2 * grid_step);
-    fit.crossing_high_s = std::max(fit.crossing_high_s, crossing + 2 * grid_step);
-    fit.knee_low_s = std::min(fit.knee_low_s, knees[k] - 2 * grid_step);
-    fit.knee_high_s = std::max(fit.knee_high_s, knees[k] + 2 * grid_step);
-  }
-  fit.crossing_middle_s = 0.5 * (fit.crossing_low_s + fit.crossing_high_s);
+  SetIntervals(t_s, lag_free, search, options, fit);
   return fit;
 }
 
