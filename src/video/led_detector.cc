@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include "liftoff/core/text.h"
@@ -329,6 +330,10 @@ struct LedDetector::Impl {
   int rejected_region = -1;
 
   size_t Slot(int64_t frame) const { return static_cast<size_t>(frame % ring); }
+  // index of a region's sum at a frame in region_sums
+  size_t RegionSlot(int region, int64_t frame) const {
+    return Slot(frame) * static_cast<size_t>(regions) + static_cast<size_t>(region);
+  }
   double FlatFrac() const { return located ? kFlatFracLocated : kFlatFracRoi; }
   size_t Cells() const { return static_cast<size_t>(grid.cells()); }
 
@@ -409,8 +414,16 @@ struct LedDetector::Impl {
   // LED hides its brightest pixel)
   double Contrast(int region, int64_t k, bool rise);
 
+  // a step of `region` at frame k becomes a pending event when it is clean, stands out
+  // from the frame's other regions and looks like a light
   void TestStep(int region, int64_t k, bool rise, double min_step, double jump,
                 double& outlier_jump, double& outlier_contrast);
+  // the region's window around k: a step of at least min_step, flat on both sides, whose
+  // frames cross the threshold only at k; nullopt otherwise
+  std::optional<WindowShape> CleanStep(int region, int64_t k, bool rise, double min_step);
+  // the event's signal, frames and (located) levels; false when it does not look like a light
+  bool DescribeEvent(int region, int64_t k, bool rise, const WindowShape& shape, double contrast,
+                     StepEvent& event);
 
   // the step of each of the 4 x 4 cells around the block (medians of the same windows)
   void RecordCellSteps(StepEvent& event, int64_t k);
@@ -887,14 +900,11 @@ double LedDetector::Impl::Contrast(int region, int64_t k, bool rise) {
   return contrast;
 }
 
-void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_step, double jump,
-                                 double& outlier_jump, double& outlier_contrast) {
-  const auto at = [&](int64_t frame) {
-    return Slot(frame) * static_cast<size_t>(regions) + static_cast<size_t>(region);
-  };
+std::optional<WindowShape> LedDetector::Impl::CleanStep(int region, int64_t k, bool rise,
+                                                        double min_step) {
   const auto count = static_cast<size_t>(ring);
   for (size_t i = 0; i < count; ++i) {
-    window_values[i] = region_sums[at(k - kBeforeFrames + static_cast<int64_t>(i))];
+    window_values[i] = region_sums[RegionSlot(region, k - kBeforeFrames + static_cast<int64_t>(i))];
   }
   const auto before = window_values.cbegin();
   const auto before_end = before + kBeforeFrames;
@@ -904,26 +914,33 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   const auto [after_low, after_high] = std::minmax_element(after, after_end);
   const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, after_frames, rise,
                                     options.threshold_frac, window_copy);
-  const double before_level = shape.before_level, after_level = shape.after_level;
   const double step = shape.step;
-  const double before_spread = shape.before_spread;
-  if (step < min_step) return;
+  if (step < min_step) return std::nullopt;
   const double flat = FlatFrac();
-  if (before_spread > flat * step || shape.after_against > flat * step ||
+  if (shape.before_spread > flat * step || shape.after_against > flat * step ||
       shape.after_creep > kCreepFrac * step) {
-    return;
+    return std::nullopt;
   }
   // a partly lit frame just after k is the next frame's transition: wait for it
-  if (std::abs(*after - after_level) > 0.5 * flat * step) return;
-  const double off = rise ? before_level : after_level;
+  if (std::abs(*after - shape.after_level) > 0.5 * flat * step) return std::nullopt;
+  const double off = rise ? shape.before_level : shape.after_level;
   const double threshold = off + options.threshold_frac * step;
   if (rise ? !(*before_high<threshold&& * after_low> threshold)
            : !(*before_low > threshold && *after_high < threshold)) {
-    return;
+    return std::nullopt;
   }
+  return shape;
+}
+
+void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_step, double jump,
+                                 double& outlier_jump, double& outlier_contrast) {
+  // a clean step in this region's sums, larger than the frame's other jumps
+  const std::optional<WindowShape> shape = CleanStep(region, k, rise, min_step);
+  if (!shape) return;
   if (outlier_jump < 0) outlier_jump = OutlierJump(k);
   if (jump < outlier_jump) return;
 
+  // the LED's contrast: enough, and larger than the frame's other regions'
   StepEvent event;
   if (!located && !MeasureRoiStep(k, rise, event)) return;
   const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
@@ -938,6 +955,21 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   }
   if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
 
+  // the event, pending confirmation; the region takes its new level meanwhile
+  if (!DescribeEvent(region, k, rise, *shape, contrast, event)) return;
+  event.frames_to_confirm = kConfirmFrames;
+  event.level_before = level[static_cast<size_t>(region)];
+  event.level_step_before = level_step[static_cast<size_t>(region)];
+  level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
+  level_step[static_cast<size_t>(region)] = static_cast<float>(shape->step);
+  ++events_per_region[static_cast<size_t>(region)];
+  pending.push_back(std::move(event));
+}
+
+bool LedDetector::Impl::DescribeEvent(int region, int64_t k, bool rise, const WindowShape& shape,
+                                      double contrast, StepEvent& event) {
+  const double step = shape.step;
+  const double off = rise ? shape.before_level : shape.after_level;
   event.region = region;
   event.rise = rise;
   event.signal_step = step;
@@ -949,26 +981,18 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
     event.index.push_back(ring_index[Slot(frame)]);
     event.t_ns.push_back(ring_t_ns[Slot(frame)]);
   }
-  if (located) {
-    // the block's own sums date the step
-    event.off = off;
-    event.on = off + step;
-    event.noise = 0.5 * std::max({before_spread, shape.after_against, shape.after_creep});
-    event.off_levels = event.off / (3.0 * pixels_per_region);
-    event.on_levels = event.on / (3.0 * pixels_per_region);
-    for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
-      event.value.push_back(region_sums[at(frame)]);
-    }
-    RecordCellSteps(event, k);
-    if (!LooksLikeALight(event)) return;
+  if (!located) return true;
+  // the block's own sums date the step
+  event.off = off;
+  event.on = off + step;
+  event.noise = 0.5 * std::max({shape.before_spread, shape.after_against, shape.after_creep});
+  event.off_levels = event.off / (3.0 * pixels_per_region);
+  event.on_levels = event.on / (3.0 * pixels_per_region);
+  for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
+    event.value.push_back(region_sums[RegionSlot(region, frame)]);
   }
-  event.frames_to_confirm = kConfirmFrames;
-  event.level_before = level[static_cast<size_t>(region)];
-  event.level_step_before = level_step[static_cast<size_t>(region)];
-  level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
-  level_step[static_cast<size_t>(region)] = static_cast<float>(step);
-  ++events_per_region[static_cast<size_t>(region)];
-  pending.push_back(std::move(event));
+  RecordCellSteps(event, k);
+  return LooksLikeALight(event);
 }
 
 void LedDetector::Impl::RecordCellSteps(StepEvent& event, int64_t k) {
