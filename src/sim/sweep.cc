@@ -123,15 +123,12 @@ std::string SweepResult::Brief() const {
 // ---------------------------------------------------------------------------------------
 // the sweep
 
-Result<SweepResult> RunSweep(const ModelDescription& description, const SweepOptions& options,
-                             const SweepProgressCallback& progress) {
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+namespace {
 
-  // every run's options, each checked against the model before any run starts
-  SweepResult sweep;
-  sweep.model_name = description.name;
-  sweep.tension_points = options.tension_points;
-  sweep.feet = options.feet;
+// Every run's entry in `sweep` and its options, each checked against the model before any
+// run starts.
+Result<std::vector<ExperimentOptions>> PlanRuns(const ModelDescription& description,
+                                                const SweepOptions& options, SweepResult& sweep) {
   std::vector<ExperimentOptions> run_options;
   for (Foot foot : options.feet) {
     for (size_t t = 0; t < options.tension_points.size(); ++t) {
@@ -148,68 +145,112 @@ Result<SweepResult> RunSweep(const ModelDescription& description, const SweepOpt
       run_options.push_back(std::move(run));
     }
   }
+  return run_options;
+}
+
+// The sweep's work queue: each worker takes the next run index; results land in their own
+// slot, so the order and the values do not depend on the threads.
+class SweepWorkers {
+ public:
+  SweepWorkers(const ModelDescription& description,
+               const std::vector<ExperimentOptions>& run_options, const SweepOptions& options,
+               const SweepProgressCallback& progress, SweepResult& sweep)
+      : description_(description),
+        run_options_(run_options),
+        progress_(progress),
+        sweep_(sweep),
+        run_count_(static_cast<int>(sweep.runs.size())),
+        failures_(Index(run_count_)),
+        last_progress_(Index(run_count_)) {
+    control_.progress_period_s = options.progress_period_s;
+    control_.stop_once_decided = options.stop_once_decided;
+  }
+
+  // one worker: runs until the queue is empty
+  void Work() {
+    for (int i = next_run_.fetch_add(1); i < run_count_; i = next_run_.fetch_add(1)) {
+      SweepRun& entry = sweep_.runs[Index(i)];
+      auto on_progress = [&](const RunProgress& run_progress) {
+        std::lock_guard<std::mutex> lock(report_mutex_);
+        last_progress_[Index(i)] = run_progress;
+        if (progress_) progress_(Report(i, run_progress));
+      };
+      auto result =
+          RunExperimentWithProgress(description_, run_options_[Index(i)], control_, on_progress);
+      std::lock_guard<std::mutex> lock(report_mutex_);
+      ++runs_done_;
+      if (!result.ok()) {
+        failures_[Index(i)] = result.status().WithContext(RunName(entry.foot, entry.tension_point));
+        continue;
+      }
+      entry.result = std::move(result).value();
+      if (!progress_) continue;
+      SweepProgress report = Report(i, last_progress_[Index(i)]);
+      report.finished = &entry;
+      progress_(report);
+    }
+  }
+
+  // the first failure in run order (the same whatever the threads)
+  Status FirstFailure() const {
+    for (const Status& failure : failures_) {
+      if (!failure.ok()) return failure;
+    }
+    return Status::Ok();
+  }
+
+ private:
+  // called with report_mutex_ held
+  SweepProgress Report(int i, const RunProgress& run) const {
+    const SweepRun& entry = sweep_.runs[Index(i)];
+    SweepProgress report;
+    report.runs_done = runs_done_;
+    report.runs_total = run_count_;
+    report.run_index = i;
+    report.foot = entry.foot;
+    report.tension_point = &entry.tension_point;
+    report.run = run;
+    return report;
+  }
+
+  const ModelDescription& description_;
+  const std::vector<ExperimentOptions>& run_options_;
+  const SweepProgressCallback& progress_;
+  SweepResult& sweep_;
+  const int run_count_;
+  RunControl control_;
+  std::atomic<int> next_run_{0};
+  std::mutex report_mutex_;  // serialises progress calls and the bookkeeping below
+  int runs_done_ = 0;
+  std::vector<Status> failures_;
+  std::vector<RunProgress> last_progress_;
+};
+
+}  // namespace
+
+Result<SweepResult> RunSweep(const ModelDescription& description, const SweepOptions& options,
+                             const SweepProgressCallback& progress) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  SweepResult sweep;
+  sweep.model_name = description.name;
+  sweep.tension_points = options.tension_points;
+  sweep.feet = options.feet;
+  LIFTOFF_ASSIGN_OR_RETURN(const std::vector<ExperimentOptions> run_options,
+                           PlanRuns(description, options, sweep));
+
+  // the threads: as asked, else the machine's, never more than the runs
   const int run_count = static_cast<int>(sweep.runs.size());
   const int available = options.threads > 0
                             ? options.threads
                             : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   sweep.threads = std::min(available, run_count);
 
-  // a work queue: each worker takes the next run index; results land in their own slot,
-  // so the order and the values do not depend on the threads
-  RunControl control;
-  control.progress_period_s = options.progress_period_s;
-  control.stop_once_decided = options.stop_once_decided;
-  std::atomic<int> next_run{0};
-  std::mutex report_mutex;  // serialises progress calls and the bookkeeping below
-  int runs_done = 0;
-  std::vector<Status> failures(Index(run_count));
-  std::vector<RunProgress> last_progress(Index(run_count));
-  auto worker = [&] {
-    for (int i = next_run.fetch_add(1); i < run_count; i = next_run.fetch_add(1)) {
-      SweepRun& entry = sweep.runs[Index(i)];
-      auto on_progress = [&](const RunProgress& run_progress) {
-        std::lock_guard<std::mutex> lock(report_mutex);
-        last_progress[Index(i)] = run_progress;
-        if (!progress) return;
-        SweepProgress report;
-        report.runs_done = runs_done;
-        report.runs_total = run_count;
-        report.run_index = i;
-        report.foot = entry.foot;
-        report.tension_point = &entry.tension_point;
-        report.run = run_progress;
-        progress(report);
-      };
-      auto result =
-          RunExperimentWithProgress(description, run_options[Index(i)], control, on_progress);
-      std::lock_guard<std::mutex> lock(report_mutex);
-      ++runs_done;
-      if (!result.ok()) {
-        failures[Index(i)] = result.status().WithContext(RunName(entry.foot, entry.tension_point));
-        continue;
-      }
-      entry.result = std::move(result).value();
-      if (!progress) continue;
-      SweepProgress report;
-      report.runs_done = runs_done;
-      report.runs_total = run_count;
-      report.run_index = i;
-      report.foot = entry.foot;
-      report.tension_point = &entry.tension_point;
-      report.run = last_progress[Index(i)];
-      report.finished = &entry;
-      progress(report);
-    }
-  };
+  SweepWorkers workers(description, run_options, options, progress, sweep);
   std::vector<std::thread> helpers;
-  for (int t = 1; t < sweep.threads; ++t) helpers.emplace_back(worker);
-  worker();
+  for (int t = 1; t < sweep.threads; ++t) helpers.emplace_back([&workers] { workers.Work(); });
+  workers.Work();
   for (std::thread& helper : helpers) helper.join();
-
-  // the first failure in run order (the same whatever the threads)
-  for (const Status& failure : failures) {
-    if (!failure.ok()) return failure;
-  }
+  LIFTOFF_RETURN_IF_ERROR(workers.FirstFailure());
   return sweep;
 }
 
