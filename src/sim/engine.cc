@@ -674,17 +674,10 @@ State InitialState(const Model& model, double lift_m) {
   return state;
 }
 
-void Step(const Model& model, const EngineOptions& options, const Controls& controls,
-          State& state) {
-  assert(controls.rest_length_m.empty() || controls.rest_length_m.size() == model.cables.size());
-  assert(controls.hinge_angle_rad.empty() ||
-         controls.hinge_angle_rad.size() == model.hinges.size());
-  assert(state.bodies.size() == model.bodies.size());
-  PrepareScratch(model, state);
-  StepScratch& scratch = state.scratch;
-  const double dt = options.time_step_s;
+namespace {
 
-  // commands: rest lengths now, hinge angles at the end of the step
+// commands: rest lengths now, hinge angles at the end of the step (as a rate over it)
+void ApplyCommands(const Model& model, const Controls& controls, double dt, State& state) {
   if (!controls.rest_length_m.empty()) {
     std::copy(controls.rest_length_m.begin(), controls.rest_length_m.end(),
               state.rest_length_m.begin());
@@ -694,8 +687,12 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
         controls.hinge_angle_rad.empty() ? state.hinge_angle_rad[h] : controls.hinge_angle_rad[h];
     state.hinge_rate_rad_per_s[h] = (target - state.hinge_angle_rad[h]) / dt;
   }
+}
 
-  // kinematics at the start of the step
+// kinematics at the start of the step: rotations, hinge frames and rates, the clusters'
+// velocities
+void StartKinematics(const Model& model, State& state) {
+  StepScratch& scratch = state.scratch;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     scratch.rotation[b] = state.bodies[b].orientation.toRotationMatrix();
     const int hinge = model.bodies[b].driving_hinge;
@@ -713,14 +710,13 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
         root.angular_velocity_rad_per_s;
   }
   scratch.start_velocity = scratch.velocity;
+}
 
-  PrepareCableTerms(model, options, state);
-
-  // contacts at the start of the step; then the velocities: one solve for the free
-  // velocity change and for A^-1 J^T, then the contact impulses; again while a cable's
-  // tension over the step leaves the law's range (held at the bound from then on)
-  FindContacts(model, options, state);
-  const int rows = BuildContactRows(model, options, state);
+// The velocities at the end of the step: one solve for the free velocity change and for
+// A^-1 J^T, then the contact impulses; again while a cable's tension over the step leaves
+// the law's range (held at the bound from then on).
+void SolveVelocities(const Model& model, const EngineOptions& options, int rows, State& state) {
+  StepScratch& scratch = state.scratch;
   do {
     AssembleSystem(model, options, state);
     if (!BandCholesky(scratch.system, scratch.band)) {
@@ -737,8 +733,11 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
     scratch.velocity = scratch.start_velocity + solution.col(0);
     SolveContacts(options, state, rows);
   } while (HoldCablesOutOfRange(model, options, state));
+}
 
-  // positions from the new velocities
+// positions from the new velocities: the clusters' roots, then the hinged children
+void Integrate(const Model& model, const Controls& controls, double dt, State& state) {
+  StepScratch& scratch = state.scratch;
   for (size_t k = 0; k < scratch.cluster_root.size(); ++k) {
     BodyState& root = state.bodies[Index(scratch.cluster_root[k])];
     const Eigen::Index at = static_cast<Eigen::Index>(6 * k);
@@ -756,6 +755,27 @@ void Step(const Model& model, const EngineOptions& options, const Controls& cont
     PlaceChild(model, static_cast<int>(h), state.hinge_angle_rad[h], state);
     ChildVelocity(model, static_cast<int>(h), state.hinge_rate_rad_per_s[h], state);
   }
+}
+
+}  // namespace
+
+void Step(const Model& model, const EngineOptions& options, const Controls& controls,
+          State& state) {
+  assert(controls.rest_length_m.empty() || controls.rest_length_m.size() == model.cables.size());
+  assert(controls.hinge_angle_rad.empty() ||
+         controls.hinge_angle_rad.size() == model.hinges.size());
+  assert(state.bodies.size() == model.bodies.size());
+  PrepareScratch(model, state);
+  const double dt = options.time_step_s;
+
+  ApplyCommands(model, controls, dt, state);
+  StartKinematics(model, state);
+  PrepareCableTerms(model, options, state);
+  // contacts at the start of the step, then the velocities and positions at its end
+  FindContacts(model, options, state);
+  const int rows = BuildContactRows(model, options, state);
+  SolveVelocities(model, options, rows, state);
+  Integrate(model, controls, dt, state);
   state.time_s += dt;
   ++state.step_count;
 }
