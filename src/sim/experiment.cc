@@ -69,92 +69,132 @@ std::string_view RunStatusName(RunStatus status) {
 // ---------------------------------------------------------------------------------------
 // options
 
-Status ExperimentOptions::Validate() const {
-  if (pulled_group && *pulled_group != CableGroup::kHR && *pulled_group != CableGroup::kHL) {
+namespace {
+
+// the pulled group and the tension point
+Status ValidateMotionAndTension(const ExperimentOptions& o) {
+  if (o.pulled_group && *o.pulled_group != CableGroup::kHR && *o.pulled_group != CableGroup::kHL) {
     return InvalidArgumentError("pulled_group: expected HR or HL, got " +
-                                std::string(CableGroupName(*pulled_group)));
+                                std::string(CableGroupName(*o.pulled_group)));
   }
-  if (!tension_point && (tension_point_index < 0 || tension_point_index > 4)) {
-    return Invalid("tension_point_index", "an integer in [0, 4]", tension_point_index);
+  if (!o.tension_point && (o.tension_point_index < 0 || o.tension_point_index > 4)) {
+    return Invalid("tension_point_index", "an integer in [0, 4]", o.tension_point_index);
   }
-  if (tension_point) {
-    if (!(tension_point->silicone_n_per_m > 0.0 &&
-          std::isfinite(tension_point->silicone_n_per_m))) {
+  if (o.tension_point) {
+    if (!(o.tension_point->silicone_n_per_m > 0.0 &&
+          std::isfinite(o.tension_point->silicone_n_per_m))) {
       return Invalid("tension_point.silicone_n_per_m", "a number > 0",
-                     tension_point->silicone_n_per_m);
+                     o.tension_point->silicone_n_per_m);
     }
-    if (!(tension_point->buna_n_n_per_m > 0.0 && std::isfinite(tension_point->buna_n_n_per_m))) {
-      return Invalid("tension_point.buna_n_n_per_m", "a number > 0", tension_point->buna_n_n_per_m);
+    if (!(o.tension_point->buna_n_n_per_m > 0.0 &&
+          std::isfinite(o.tension_point->buna_n_n_per_m))) {
+      return Invalid("tension_point.buna_n_n_per_m", "a number > 0",
+                     o.tension_point->buna_n_n_per_m);
     }
-    if (!(tension_point->spring_n_per_m > 0.0 && std::isfinite(tension_point->spring_n_per_m))) {
-      return Invalid("tension_point.spring_n_per_m", "a number > 0", tension_point->spring_n_per_m);
+    if (!(o.tension_point->spring_n_per_m > 0.0 &&
+          std::isfinite(o.tension_point->spring_n_per_m))) {
+      return Invalid("tension_point.spring_n_per_m", "a number > 0",
+                     o.tension_point->spring_n_per_m);
     }
   }
+  return Status::Ok();
+}
+
+// pretension ratios and cable damping
+Status ValidateCables(const ExperimentOptions& o) {
   const std::array<std::pair<std::string_view, double>, 4> ratios = {
-      {{"pretension_ratios.top_m", pretension_ratios.top_m},
-       {"pretension_ratios.bottom_m", pretension_ratios.bottom_m},
-       {"pretension_ratios.saddle_m", pretension_ratios.saddle_m},
-       {"pretension_ratios.side_m", pretension_ratios.side_m}}};
+      {{"pretension_ratios.top_m", o.pretension_ratios.top_m},
+       {"pretension_ratios.bottom_m", o.pretension_ratios.bottom_m},
+       {"pretension_ratios.saddle_m", o.pretension_ratios.saddle_m},
+       {"pretension_ratios.side_m", o.pretension_ratios.side_m}}};
   for (const auto& [field, value] : ratios) {
     if (!(value >= 0.0 && value < 1.0)) return Invalid(field, "a number in [0, 1)", value);
   }
-  if (!(cable_damping_n_s_per_m >= 0.0 && std::isfinite(cable_damping_n_s_per_m))) {
-    return Invalid("cable_damping_n_s_per_m", "a number >= 0", cable_damping_n_s_per_m);
-  }
-  if (!(drop_height_m >= 0.0 && drop_height_m <= 0.5)) {
-    return Invalid("drop_height_m", "a number in [0, 0.5]", drop_height_m);
-  }
-  if (!(bend_start_s >= 0.0 && bend_start_s <= 3600.0)) {
-    return Invalid("bend_start_s", "a number in [0, 3600]", bend_start_s);
-  }
-  if (!(bend_speed_m_per_s > 0.0 && bend_speed_m_per_s <= 10.0)) {
-    return Invalid("bend_speed_m_per_s", "a number in (0, 10]", bend_speed_m_per_s);
-  }
-  if (!(bend_fraction > 0.0 && bend_fraction <= 1.0)) {
-    return Invalid("bend_fraction", "a number in (0, 1]", bend_fraction);
-  }
-  if (!(ramp_start_s >= 0.0 && ramp_start_s <= 3600.0)) {
-    return Invalid("ramp_start_s", "a number in [0, 3600]", ramp_start_s);
-  }
-  if (!(ramp_duration_s > 0.0 && ramp_duration_s <= 3600.0)) {
-    return Invalid("ramp_duration_s", "a number in (0, 3600]", ramp_duration_s);
-  }
-  if (!(ramp_angle_rad >= 0.0 && ramp_angle_rad <= std::numbers::pi)) {
-    return Invalid("ramp_angle_rad", "a number in [0, pi]", ramp_angle_rad);
-  }
-  if (!(liftoff_threshold_m > 0.0 && liftoff_threshold_m <= 1.0)) {
-    return Invalid("liftoff_threshold_m", "a number in (0, 1]", liftoff_threshold_m);
-  }
-  if (!(ground_clearance_m >= 0.0 && ground_clearance_m <= 1.0)) {
-    return Invalid("ground_clearance_m", "a number in [0, 1]", ground_clearance_m);
-  }
-  if (!(stop_after_liftoff_rad >= 0.0)) {
-    return Invalid("stop_after_liftoff_rad", "a number >= 0 (or infinity)", stop_after_liftoff_rad);
-  }
-  if (friction && !(*friction >= 0.0 && std::isfinite(*friction))) {
-    return Invalid("friction", "a number >= 0", *friction);
-  }
-  if (foot_marker_height_m && !(*foot_marker_height_m >= 0.0 && *foot_marker_height_m <= 100.0)) {
-    return Invalid("foot_marker_height_m", "a number in [0, 100]", *foot_marker_height_m);
-  }
-  if (spine_friction && !(*spine_friction >= 0.0 && std::isfinite(*spine_friction))) {
-    return Invalid("spine_friction", "a number >= 0", *spine_friction);
-  }
-  LIFTOFF_RETURN_IF_ERROR(engine.Validate().WithContext("engine"));
-  const double dt = engine.time_step_s;
-  if (!(sample_period_s >= dt && sample_period_s <= 10.0) ||
-      !IsWholeMultiple(sample_period_s, dt)) {
-    return InvalidArgumentError("sample_period_s: expected a whole multiple of the time step " +
-                                FormatNumber(dt) + " s (at most 10 s), got " +
-                                FormatNumber(sample_period_s));
-  }
-  if (!(reference_time_s >= 0.0 && reference_time_s <= ramp_start_s) ||
-      !IsWholeMultiple(reference_time_s, sample_period_s)) {
-    return InvalidArgumentError(
-        "reference_time_s: expected a multiple of sample_period_s between 0 and ramp_start_s " +
-        FormatNumber(ramp_start_s) + ", got " + FormatNumber(reference_time_s));
+  if (!(o.cable_damping_n_s_per_m >= 0.0 && std::isfinite(o.cable_damping_n_s_per_m))) {
+    return Invalid("cable_damping_n_s_per_m", "a number >= 0", o.cable_damping_n_s_per_m);
   }
   return Status::Ok();
+}
+
+// the drop, the bend and the ramp
+Status ValidateSchedule(const ExperimentOptions& o) {
+  if (!(o.drop_height_m >= 0.0 && o.drop_height_m <= 0.5)) {
+    return Invalid("drop_height_m", "a number in [0, 0.5]", o.drop_height_m);
+  }
+  if (!(o.bend_start_s >= 0.0 && o.bend_start_s <= 3600.0)) {
+    return Invalid("bend_start_s", "a number in [0, 3600]", o.bend_start_s);
+  }
+  if (!(o.bend_speed_m_per_s > 0.0 && o.bend_speed_m_per_s <= 10.0)) {
+    return Invalid("bend_speed_m_per_s", "a number in (0, 10]", o.bend_speed_m_per_s);
+  }
+  if (!(o.bend_fraction > 0.0 && o.bend_fraction <= 1.0)) {
+    return Invalid("bend_fraction", "a number in (0, 1]", o.bend_fraction);
+  }
+  if (!(o.ramp_start_s >= 0.0 && o.ramp_start_s <= 3600.0)) {
+    return Invalid("ramp_start_s", "a number in [0, 3600]", o.ramp_start_s);
+  }
+  if (!(o.ramp_duration_s > 0.0 && o.ramp_duration_s <= 3600.0)) {
+    return Invalid("ramp_duration_s", "a number in (0, 3600]", o.ramp_duration_s);
+  }
+  if (!(o.ramp_angle_rad >= 0.0 && o.ramp_angle_rad <= std::numbers::pi)) {
+    return Invalid("ramp_angle_rad", "a number in [0, pi]", o.ramp_angle_rad);
+  }
+  return Status::Ok();
+}
+
+// liftoff detection, ground and friction
+Status ValidateContact(const ExperimentOptions& o) {
+  if (!(o.liftoff_threshold_m > 0.0 && o.liftoff_threshold_m <= 1.0)) {
+    return Invalid("liftoff_threshold_m", "a number in (0, 1]", o.liftoff_threshold_m);
+  }
+  if (!(o.ground_clearance_m >= 0.0 && o.ground_clearance_m <= 1.0)) {
+    return Invalid("ground_clearance_m", "a number in [0, 1]", o.ground_clearance_m);
+  }
+  if (!(o.stop_after_liftoff_rad >= 0.0)) {
+    return Invalid("stop_after_liftoff_rad", "a number >= 0 (or infinity)",
+                   o.stop_after_liftoff_rad);
+  }
+  if (o.friction && !(*o.friction >= 0.0 && std::isfinite(*o.friction))) {
+    return Invalid("friction", "a number >= 0", *o.friction);
+  }
+  if (o.foot_marker_height_m &&
+      !(*o.foot_marker_height_m >= 0.0 && *o.foot_marker_height_m <= 100.0)) {
+    return Invalid("foot_marker_height_m", "a number in [0, 100]", *o.foot_marker_height_m);
+  }
+  if (o.spine_friction && !(*o.spine_friction >= 0.0 && std::isfinite(*o.spine_friction))) {
+    return Invalid("spine_friction", "a number >= 0", *o.spine_friction);
+  }
+  return Status::Ok();
+}
+
+// the engine, and the sampling on its time step
+Status ValidateSampling(const ExperimentOptions& o) {
+  LIFTOFF_RETURN_IF_ERROR(o.engine.Validate().WithContext("engine"));
+  const double dt = o.engine.time_step_s;
+  if (!(o.sample_period_s >= dt && o.sample_period_s <= 10.0) ||
+      !IsWholeMultiple(o.sample_period_s, dt)) {
+    return InvalidArgumentError("sample_period_s: expected a whole multiple of the time step " +
+                                FormatNumber(dt) + " s (at most 10 s), got " +
+                                FormatNumber(o.sample_period_s));
+  }
+  if (!(o.reference_time_s >= 0.0 && o.reference_time_s <= o.ramp_start_s) ||
+      !IsWholeMultiple(o.reference_time_s, o.sample_period_s)) {
+    return InvalidArgumentError(
+        "reference_time_s: expected a multiple of sample_period_s between 0 and ramp_start_s " +
+        FormatNumber(o.ramp_start_s) + ", got " + FormatNumber(o.reference_time_s));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+// Validate() in the fields' order, a group at a time; the first error wins.
+Status ExperimentOptions::Validate() const {
+  LIFTOFF_RETURN_IF_ERROR(ValidateMotionAndTension(*this));
+  LIFTOFF_RETURN_IF_ERROR(ValidateCables(*this));
+  LIFTOFF_RETURN_IF_ERROR(ValidateSchedule(*this));
+  LIFTOFF_RETURN_IF_ERROR(ValidateContact(*this));
+  return ValidateSampling(*this);
 }
 
 TensionPoint ExperimentOptions::EffectiveTensionPoint() const {
