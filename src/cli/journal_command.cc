@@ -1,0 +1,68 @@
+// `liftoff journal JOURNAL [--replay [-o LOG]]`: a capture journal shown, or its log rebuilt.
+#include "liftoff/cli/capture_commands.h"
+
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include "cli_common.h"
+#include "liftoff/capture/journal.h"
+#include "liftoff/core/output.h"
+
+namespace liftoff::cli {
+
+int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& err) {
+  if (!command.replay) {
+    if (!command.output_path.empty()) {
+      return ReportError(InvalidArgumentError("--output: only with --replay"), err);
+    }
+    capture::JournalDumpOptions options;
+    options.text = !command.hex;
+    options.max_records = command.max_records;
+    if (command.max_records < 0) {
+      return ReportError(InvalidArgumentError("--max-records: expected >= 0, got " +
+                                              std::to_string(command.max_records)),
+                         err);
+    }
+    const Status dumped = capture::DumpJournal(command.journal_path, options, out);
+    if (!dumped.ok()) return ReportError(dumped, err);
+    return kExitOk;
+  }
+
+  // replay: the log as live capture would have written it
+  if (!command.output_path.empty()) {
+    const Status refused = RefuseToReplace(command.output_path, "", command.force);
+    if (!refused.ok()) return ReportError(refused, err);
+  }
+  auto calibration = ChooseCalibration(command.calibration);
+  if (!calibration.ok()) return ReportError(calibration.status(), err);
+  auto replay = capture::ReplayJournal(command.journal_path, *calibration);
+  if (!replay.ok()) return ReportError(replay.status(), err);
+  if (replay->truncated) {
+    err << "warning: " << command.journal_path.string() << ": the last record is cut off ("
+        << replay->truncated_bytes << " bytes skipped: the capture stopped mid-write)\n";
+  }
+  out << replay->Brief() << '\n';
+  if (command.output_path.empty()) return kExitOk;
+  const Status written = WriteControllerLog(command.output_path, replay->log);
+  if (!written.ok()) return ReportError(written, err);
+  err << "wrote " << command.output_path.string() << '\n';
+  return kExitOk;
+}
+
+Subcommand AddJournalCommand(CLI::App& parent) {
+  auto command = std::make_shared<JournalCommand>();
+  CLI::App* app =
+      parent.add_subcommand("journal", "Show a capture journal, or rebuild its controller log");
+  app->add_option("journal", command->journal_path, "Capture journal")->required();
+  app->add_flag("--replay", command->replay,
+                "Rebuild the controller log with live capture's parsing");
+  app->add_option("--output,-o", command->output_path, "With --replay: log to write");
+  app->add_flag("--force", command->force, "Overwrite an existing output file");
+  app->add_flag("--hex", command->hex, "Dump bytes as hexadecimal");
+  app->add_option("--max-records", command->max_records, "Dump at most this many records");
+  AddCalibrationFlag(*app, command->calibration);
+  return RunsWith(app, command, RunJournal);
+}
+
+}  // namespace liftoff::cli
