@@ -409,8 +409,14 @@ Result<JournalReplay> ReplayJournal(const std::filesystem::path& path,
   return replay;
 }
 
+Status JournalDumpOptions::Validate() const {
+  if (max_records >= 0) return Status::Ok();
+  return InvalidArgumentError("max_records: expected >= 0, got " + std::to_string(max_records));
+}
+
 Status DumpJournal(const std::filesystem::path& path, const JournalDumpOptions& options,
                    std::ostream& out) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
   JournalReader reader;
   LIFTOFF_RETURN_IF_ERROR(reader.Open(path));
   const JournalHeader& header = reader.header();

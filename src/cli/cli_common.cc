@@ -69,10 +69,26 @@ void AddLookupFlags(CLI::App& app, LookupChoice& lookup) {
       ->capture_default_str();
 }
 
+Status NameFlagsIn(const Status& status,
+                   std::initializer_list<std::pair<std::string, std::string>> flag_fields) {
+  if (status.ok()) return status;
+  for (const auto& [flag, field] : flag_fields) {
+    if (auto message = MessageNamingFlag(status.message(), flag, field, false)) {
+      return Status(status.code(), *message);
+    }
+  }
+  return status;
+}
+
 Status CheckMaxBadLinesFlag(int64_t max_bad_lines) {
-  if (max_bad_lines >= 0) return Status::Ok();
-  return InvalidArgumentError("--max-bad-lines: expected an integer >= 0, got " +
-                              std::to_string(max_bad_lines));
+  LogReadOptions options;
+  options.max_bad_lines = max_bad_lines;
+  return NameFlagsIn(options.Validate(), {{"--max-bad-lines", "LogReadOptions.max_bad_lines"}});
+}
+
+Status CheckLookupFlags(const sync::LookupOptions& options) {
+  return NameFlagsIn(options.Validate(), {{"--gap-threshold", "lookup options.gap_threshold_s"},
+                                          {"--max-past-end", "lookup options.max_past_end_s"}});
 }
 
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
@@ -83,13 +99,9 @@ Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice) {
     return InvalidArgumentError("--rule: expected linear or hold, got \"" + choice.rule + "\"");
   }
   options.rule = *rule;
-  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--gap-threshold", choice.gap_threshold_s,
-                                         sync::LookupOptions::kGapThresholdRange, "s"));
-  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--max-past-end", choice.max_past_end_s,
-                                         sync::LookupOptions::kMaxPastEndRange, "s"));
   options.gap_threshold_s = choice.gap_threshold_s;
   options.max_past_end_s = choice.max_past_end_s;
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  LIFTOFF_RETURN_IF_ERROR(CheckLookupFlags(options));
   return options;
 }
 

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <filesystem>
+#include <initializer_list>
 #include <iosfwd>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "liftoff/cli/commands.h"
@@ -32,8 +34,17 @@ Result<Calibration> ChooseCalibration(const CalibrationChoice& choice,
 Status CheckFlagRange(std::string_view flag, double value, const NumberRange& range,
                       std::string_view unit = "");
 
-/// OK when `--max-bad-lines` is >= 0, else kInvalidArgument naming the flag.
+/// `status` from an option struct's Validate() with the field it names replaced by its
+/// flag (`flag_fields`: {"--gap-threshold", "lookup options.gap_threshold_s"}, a context
+/// written "lookup options: " matching "lookup options."); other statuses as they are.
+Status NameFlagsIn(const Status& status,
+                   std::initializer_list<std::pair<std::string, std::string>> flag_fields);
+
+/// LogReadOptions' check of `--max-bad-lines` (>= 0), naming the flag.
 Status CheckMaxBadLinesFlag(int64_t max_bad_lines);
+
+/// sync::LookupOptions::Validate() naming --gap-threshold and --max-past-end.
+Status CheckLookupFlags(const sync::LookupOptions& options);
 
 /// A table command's --format; kInvalidArgument "--format: expected md, csv, latex or
 /// json, got ..." for another word.

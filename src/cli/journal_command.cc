@@ -19,11 +19,8 @@ int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& e
     capture::JournalDumpOptions options;
     options.text = !command.hex;
     options.max_records = command.max_records;
-    if (command.max_records < 0) {
-      return ReportError(InvalidArgumentError("--max-records: expected >= 0, got " +
-                                              std::to_string(command.max_records)),
-                         err);
-    }
+    const Status valid = NameFlagsIn(options.Validate(), {{"--max-records", "max_records"}});
+    if (!valid.ok()) return ReportError(valid, err);
     const Status dumped = capture::DumpJournal(command.journal_path, options, out);
     if (!dumped.ok()) return ReportError(dumped, err);
     return kExitOk;

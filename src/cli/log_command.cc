@@ -19,8 +19,9 @@ namespace liftoff::cli {
 // liftoff log
 
 int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
-  const Status gap_checked = CheckFlagRange("--gap-threshold", command.gap_threshold_s,
-                                            sync::LookupOptions::kGapThresholdRange, "s");
+  sync::LookupOptions lookup;
+  lookup.gap_threshold_s = command.gap_threshold_s;
+  const Status gap_checked = CheckLookupFlags(lookup);
   if (!gap_checked.ok()) return ReportError(gap_checked, err);
   const Status bad_lines_checked = CheckMaxBadLinesFlag(command.max_bad_lines);
   if (!bad_lines_checked.ok()) return ReportError(bad_lines_checked, err);

@@ -534,5 +534,17 @@ TEST(Journal, DumpShowsFramesAsTextWithTimesAndReportsACutOffEnd) {
   EXPECT_THAT(hex.str(), HasSubstr("  24 53 2c 30"));  // "$S,0"
 }
 
+TEST(Journal, DumpOptionsRefuseANegativeRecordCount) {
+  JournalDumpOptions options;
+  EXPECT_TRUE(options.Validate().ok());
+  options.max_records = -1;
+  const Status valid = options.Validate();
+  EXPECT_EQ(valid.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(valid.message(), "max_records: expected >= 0, got -1");
+  // checked before the file is opened
+  std::ostringstream out;
+  EXPECT_EQ(DumpJournal("no-such.journal", options, out).code(), StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace liftoff::capture

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
 #include "liftoff/core/json.h"
 #include "support/test_support.h"
@@ -356,6 +357,51 @@ TEST(CliSync, SecondsBeyondTheLimitAreRejectedNamingTheFlag) {
   std::ostringstream out, err;
   EXPECT_EQ(RunLog(log, out, err), ExitCodeFor(StatusCode::kInvalidArgument));
   EXPECT_THAT(err.str(), HasSubstr("--gap-threshold"));
+}
+
+// The lookup, log-reading and journal flags are range-checked by their option struct's
+// Validate() alone; the message names the flag as the user typed it.
+TEST(CliFlags, OptionStructValidateNamesTheFlag) {
+  ScratchDir scratch;
+  WriteFile(scratch / "ramp.txt", RampLog2018(5000));
+  const auto sync_error = [&](const LookupChoice& lookup) {
+    SyncCommand command;
+    command.log_path = scratch / "ramp.txt";
+    command.led_on_s = 1.0;
+    command.liftoff_s = 3.25;
+    command.lookup = lookup;
+    std::ostringstream out, err;
+    EXPECT_EQ(RunSync(command, out, err), ExitCodeFor(StatusCode::kInvalidArgument));
+    return err.str();
+  };
+  LookupChoice lookup;
+  lookup.gap_threshold_s = 0.0;
+  EXPECT_THAT(sync_error(lookup),
+              HasSubstr("--gap-threshold: expected a number in (0, 1e+06] s, got 0\n"));
+  lookup = {};
+  lookup.max_past_end_s = -1.0;
+  EXPECT_THAT(sync_error(lookup),
+              HasSubstr("--max-past-end: expected a number in [0, 1e+06] s, got -1\n"));
+  lookup = {};
+  lookup.max_bad_lines = -2;
+  EXPECT_THAT(sync_error(lookup),
+              HasSubstr("--max-bad-lines: expected an integer >= 0, got -2\n"));
+
+  LogCommand log;
+  log.log_path = scratch / "ramp.txt";
+  log.gap_threshold_s = -0.5;
+  std::ostringstream out, err;
+  EXPECT_EQ(RunLog(log, out, err), ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(err.str(),
+              HasSubstr("--gap-threshold: expected a number in (0, 1e+06] s, got -0.5\n"));
+
+  JournalCommand journal;
+  journal.journal_path = scratch / "none.journal";
+  journal.max_records = -1;
+  std::ostringstream journal_out, journal_err;
+  EXPECT_EQ(RunJournal(journal, journal_out, journal_err),
+            ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(journal_err.str(), HasSubstr("--max-records: expected >= 0, got -1\n"));
 }
 
 TEST(CliLog, AutoFormatRecognisesALiftoffLogBehindAByteOrderMark) {

@@ -194,12 +194,15 @@ struct JournalDumpOptions {
   /// Print received bytes as text (frames are text lines; other bytes as \xNN) rather
   /// than as hexadecimal.
   bool text = true;
+
+  /// kInvalidArgument "max_records: expected >= 0, got -1".
+  Status Validate() const;
 };
 
 /// The journal for people, written to `out` as it is read: its header, then one line per
 /// record with its host time (seconds since the capture began), kind and length, then the
 /// bytes (text frames read as they are), and a closing line that reports a cut-off last
-/// record. Errors: those of JournalReader::Open and Next.
+/// record. Errors: options.Validate()'s, then those of JournalReader::Open and Next.
 Status DumpJournal(const std::filesystem::path& path, const JournalDumpOptions& options,
                    std::ostream& out);
 
