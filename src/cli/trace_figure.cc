@@ -127,7 +127,9 @@ std::string Body(const std::string& name, const std::string& trial_id,
   std::string body = "  set multiplot layout " + std::string(led_traced && clip.foot ? "2" : "1") +
                      ",1 title \"" +
                      FigureScriptText("trial " + trial_id + ": " +
-                                      clip.video_path.filename().string()) +
+                                      clip.video_path.filename().string() +
+                                      (led_traced ? "" : " (LED located automatically: its "
+                                                         "brightness is not traced)")) +
                      "\" noenhanced\n  set xlabel \"video time (s)\"\n  set grid\n"
                      "  set key top center opaque\n" + XRange(clip);
   if (led_traced) {

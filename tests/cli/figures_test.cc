@@ -101,6 +101,7 @@ TEST(TraceFigure, WithoutTheLedTraceTheFootIsTheSecondBlock) {
   EXPECT_THAT(figure->data, Not(HasSubstr("brightness_levels\n")));
   EXPECT_THAT(figure->body, HasSubstr("index 1 using 1:2"));
   EXPECT_THAT(figure->body, HasSubstr("layout 1,1"));
+  EXPECT_THAT(figure->body, HasSubstr("LED located automatically"));
   ScratchDir scratch;
   ExpectDrawn(*figure, scratch.path());
   // the LED alone, traced: one panel; neither trace: no figure
