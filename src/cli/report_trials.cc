@@ -85,6 +85,10 @@ Result<std::vector<TrialEvidence>> WriteTrialEvidence(const CampaignAnalysis& ca
   // the verification images (a second decode of each video, up to the frames they need)
   const TrialVerifications images =
       WriteTrialVerifications(campaign.analysis, stems, dir / "trials", err);
+  if (!images.written.empty()) {
+    err << "wrote " << Plural(static_cast<int64_t>(images.written.size()), "verification image")
+        << " in " << (dir / "trials").string() << '\n';
+  }
   std::vector<TrialEvidence> evidence(outcomes.size());
   for (size_t i = 0; i < outcomes.size(); ++i) {
     TrialEvidence& trial = evidence[i];
