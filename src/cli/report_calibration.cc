@@ -374,9 +374,9 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
 namespace {
 
 // liftoff against the tension scale per foot, the hardware means, the fit and its interval
-std::optional<ReportFigure> FitFigure(const ReportCalibration& calibration) {
+std::optional<Figure> FitFigure(const ReportCalibration& calibration) {
   if (calibration.targets.empty() || calibration.grid.empty()) return std::nullopt;
-  ReportFigure figure{"fit", "liftoff rotation against the tension scale, hardware means, the fit",
+  Figure figure{"fit", "liftoff rotation against the tension scale, hardware means, the fit",
                       "", ""};
   std::string plot;
   const double low = calibration.grid.front().tension.sigma;
@@ -426,9 +426,9 @@ std::optional<ReportFigure> FitFigure(const ReportCalibration& calibration) {
 
 // per foot: the hardware trials and their range beside the Monte Carlo's values and the
 // simulation at the fit
-std::optional<ReportFigure> MonteCarloFigure(const ReportCalibration& calibration) {
+std::optional<Figure> MonteCarloFigure(const ReportCalibration& calibration) {
   if (calibration.targets.empty() && calibration.distributions.empty()) return std::nullopt;
-  ReportFigure figure{
+  Figure figure{
       "montecarlo", "per foot: hardware trials and range beside the Monte Carlo's simulated values",
       "", ""};
   auto x = [](Foot foot, double offset) {
@@ -481,8 +481,8 @@ std::optional<ReportFigure> MonteCarloFigure(const ReportCalibration& calibratio
 
 }  // namespace
 
-std::vector<ReportFigure> CalibrationFigures(const ReportCalibration& calibration) {
-  std::vector<ReportFigure> figures;
+std::vector<Figure> CalibrationFigures(const ReportCalibration& calibration) {
+  std::vector<Figure> figures;
   if (auto figure = FitFigure(calibration)) figures.push_back(std::move(*figure));
   if (auto figure = MonteCarloFigure(calibration)) figures.push_back(std::move(*figure));
   return figures;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "liftoff/cli/figures.h"
 #include "liftoff/cli/report_command.h"
 #include "liftoff/core/calibration.h"
 #include "liftoff/core/status.h"
@@ -57,18 +58,10 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
                                             const std::filesystem::path& cache_path,
                                             std::ostream& err);
 
-/// One figure: its name (files NAME.dat, NAME.gp), title, data and plot commands.
-struct ReportFigure {
-  std::string name;
-  std::string title;
-  std::string data;
-  std::string body;
-};
-
 /// "fit" (liftoff rotation against the tension scale, hardware means, the fit) and
 /// "montecarlo" (per foot: the hardware trials and range beside the Monte Carlo's values),
 /// each when there is something to draw.
-std::vector<ReportFigure> CalibrationFigures(const ReportCalibration& calibration);
+std::vector<Figure> CalibrationFigures(const ReportCalibration& calibration);
 
 /// calibration.md: the metric, the ranking, the fit and its warnings, the Monte Carlo, the
 /// files. `heading` is the top heading's level ("#" or "##").

@@ -1,16 +1,9 @@
 #include "liftoff/cli/report_command.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <map>
 #include <optional>
 #include <memory>
@@ -23,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "liftoff/cli/figures.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/markup.h"
@@ -31,8 +25,7 @@
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
 #include "report_calibration.h"
-
-extern char** environ;
+#include "report_trials.h"
 
 namespace liftoff::cli {
 namespace {
@@ -203,79 +196,6 @@ Result<SimColumn> SimulatedColumn(const ReportCommand& command, const Calibratio
 // ---------------------------------------------------------------------------------------
 // figures: data and a gnuplot script each, drawn when gnuplot is there
 
-struct Figure {
-  std::string name;
-  std::string title;
-  std::string data;
-  /// The plot commands; the script around them sets the terminals.
-  std::string body;
-};
-
-// a string gnuplot reads as one field of a data file
-std::string DataText(std::string_view text) {
-  std::string quoted = "\"";
-  for (const char c : text) quoted += c == '"' ? '\'' : c;
-  return quoted + "\"";
-}
-
-// the script: the body drawn once as PNG and once as SVG, beside the script
-std::string FigureScript(const Figure& figure) {
-  return "# liftoff report: " + figure.title +
-         ".\n# Data: " + figure.name + ".dat. Restyle here and rerun `gnuplot " + figure.name +
-         ".gp` in this folder.\n"
-         "do for [format in \"png svg\"] {\n"
-         "  if (format eq \"png\") {\n"
-         "    set terminal pngcairo size 1200,800 font \",11\"\n"
-         "  } else {\n"
-         "    set terminal svg size 1200,800 font \"sans,11\"\n"
-         "  }\n"
-         "  set output \"" + figure.name + ".\".format\n" +
-         figure.body + "  unset output\n}\n";
-}
-
-// (a) each trial's liftoff rotation with its interval, the simulated values of its foot
-Figure TrialsFigure(const std::vector<stats::TrialValue>& values, const stats::SimResults* sim) {
-  Figure figure{"trials", "liftoff rotation per trial beside the simulation", "", ""};
-  std::string& data = figure.data;
-  data = "# block 0: index rotation_rad lower_rad upper_rad trial foot\n";
-  std::map<Foot, std::pair<size_t, size_t>> span_by_foot;
-  for (size_t i = 0; i < values.size(); ++i) {
-    const stats::TrialValue& value = values[i];
-    if (!std::isfinite(value.liftoff_rad)) continue;
-    const bool interval = std::isfinite(value.lower_rad) && std::isfinite(value.upper_rad);
-    data += std::to_string(i) + " " + FormatNumber(value.liftoff_rad) + " " +
-            FormatNumber(interval ? value.lower_rad : value.liftoff_rad) + " " +
-            FormatNumber(interval ? value.upper_rad : value.liftoff_rad) + " " +
-            DataText(value.trial_id) + " " + std::string(FootName(value.foot)) + "\n";
-    auto [entry, added] = span_by_foot.try_emplace(value.foot, i, i);
-    if (!added) entry->second.second = i;
-  }
-  data += "\n\n# block 1: from_index to_index liftoff_rad tension_point (simulation)\n";
-  bool any_sim = false;
-  for (const stats::SimRun& run : sim ? sim->runs : std::vector<stats::SimRun>()) {
-    const auto span = span_by_foot.find(run.foot);
-    if (!run.stood || !run.liftoff_rad || span == span_by_foot.end()) continue;
-    data += FormatFixed(static_cast<double>(span->second.first) - 0.4, 1) + " " +
-            FormatFixed(static_cast<double>(span->second.second) + 0.4, 1) + " " +
-            FormatNumber(*run.liftoff_rad) + " " + DataText(run.tension_point) + "\n";
-    any_sim = true;
-  }
-  if (!any_sim) data += "-1 -1 0 \"none\"\n";  // an empty block would stop gnuplot
-  figure.body =
-      "  set title \"Rotation at liftoff per trial: hardware (interval) beside simulation\"\n"
-      "  set ylabel \"|vertebra rotation| at liftoff (rad)\"\n"
-      "  set xlabel \"trial\"\n"
-      "  set xrange [-1:" + std::to_string(values.size()) + "]\n"
-      "  set grid ytics\n"
-      "  set key top left\n"
-      "  plot \"trials.dat\" index 0 using 1:2:3:4:xticlabels(5) with yerrorbars pt 7 lc rgb "
-      "\"#1f77b4\" title \"hardware\", \\\n"
-      "       \"\" index 1 using 1:3:($2-$1):(0) with vectors nohead lw 2 lc rgb \"#d62728\" "
-      "title \"simulation (per tension point)\", \\\n"
-      "       \"\" index 1 using 2:3:4 with labels left offset 0.5,0 font \",8\" notitle\n";
-  return figure;
-}
-
 // (b) the paper's Figure 7: per foot, the simulated height against |rotation| for each
 // tension point, the hardware's liftoff range as dashed vertical lines
 std::optional<Figure> Figure7(const std::vector<SimCurve>& curves,
@@ -330,47 +250,6 @@ std::optional<Figure> Figure7(const std::vector<SimCurve>& curves,
   return figure;
 }
 
-// Runs `gnuplot -e "cd 'DIR'" NAME.gp`, its output into NAME.log (removed when empty).
-Status DrawFigure(const std::string& program, const fs::path& dir, const std::string& name) {
-  const std::string cd = "cd '" + dir.string() + "'";
-  const std::string script = (dir / (name + ".gp")).string();
-  const std::string log = (dir / (name + ".log")).string();
-  std::vector<std::string> arguments = {program, "-e", cd, script};
-  std::vector<char*> argv;
-  for (std::string& argument : arguments) argv.push_back(argument.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = 0;
-  const int spawned = posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) {
-    return NotFoundError(program + ": cannot run it (" + std::strerror(spawned) +
-                         "); install gnuplot (Debian: gnuplot-nox)");
-  }
-  int wait_status = 0;
-  if (waitpid(pid, &wait_status, 0) != pid || !WIFEXITED(wait_status) ||
-      WEXITSTATUS(wait_status) != 0) {
-    return IoError(program + " failed on " + script + "; its messages are in " + log);
-  }
-  std::error_code error;
-  if (fs::file_size(log, error) == 0) fs::remove(log, error);
-  return Status::Ok();
-}
-
-// Writes NAME.dat and NAME.gp, then draws NAME.png and NAME.svg. A write error is an
-// error; gnuplot missing or failing comes back as `drawn`.
-Status WriteFigure(const Figure& figure, const fs::path& dir, const std::string& gnuplot,
-                   Status& drawn) {
-  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / (figure.name + ".dat"), figure.data));
-  LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / (figure.name + ".gp"), FigureScript(figure)));
-  if (drawn.ok()) drawn = DrawFigure(gnuplot, dir, figure.name);
-  return Status::Ok();
-}
-
 // ---------------------------------------------------------------------------------------
 // the report pages
 
@@ -383,17 +262,11 @@ struct ReportContent {
   /// The calibration (with the simulation).
   const ReportCalibration* calibration = nullptr;
   std::vector<Figure> figures;
+  /// Per trial: its traces figure and verification image.
+  std::vector<TrialEvidence> evidence;
   /// OK when gnuplot drew every figure.
   Status drawn;
 };
-
-// "A1: 0.412 rad in [0.405, 0.419]" or the failure
-std::string TrialStatus(const sync::TrialOutcome& outcome) {
-  if (!outcome.status.ok()) return "failed: " + outcome.status.ToString();
-  const sync::LiftoffMeasurement& measured = *outcome.measurement;
-  return "ok: " + FormatFixed(measured.liftoff_rad, 3) + " rad in [" +
-         FormatFixed(measured.lower_rad, 3) + ", " + FormatFixed(measured.upper_rad, 3) + "]";
-}
 
 std::string SimDescription(const ReportContent& content) {
   if (content.sim == nullptr) return "none (--no-sim)";
@@ -431,30 +304,7 @@ std::string ReportMarkdown(const ReportContent& content) {
             figure.name + ".dat](figures/" + figure.name + ".dat)\n\n";
   }
   if (content.calibration) text += CalibrationMarkdown(*content.calibration, "##") + "\n";
-  text += "## Trials\n\n";
-  const auto& outcomes = content.campaign->analysis.outcomes;
-  for (size_t i = 0; i < outcomes.size(); ++i) {
-    text += "- " + outcomes[i].trial.id + " (foot " + std::string(FootName(outcomes[i].trial.foot)) +
-            "): " + TrialStatus(outcomes[i]) + "\n";
-    for (const std::string& note : content.campaign->notes[i]) text += "  - " + note + "\n";
-  }
-  return text;
-}
-
-std::string Base64(std::string_view bytes) {
-  static constexpr char kDigits[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string encoded;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t group = static_cast<uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) group |= static_cast<uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8;
-    if (i + 2 < bytes.size()) group |= static_cast<uint32_t>(static_cast<unsigned char>(bytes[i + 2]));
-    encoded += kDigits[(group >> 18) & 63];
-    encoded += kDigits[(group >> 12) & 63];
-    encoded += i + 1 < bytes.size() ? kDigits[(group >> 6) & 63] : '=';
-    encoded += i + 2 < bytes.size() ? kDigits[group & 63] : '=';
-  }
-  return encoded;
+  return text + TrialsMarkdown(*content.campaign, content.evidence, content.drawn.ok());
 }
 
 std::string HtmlNumber(double value) {
@@ -481,12 +331,14 @@ std::string HtmlTable(const stats::ResultsTable& table) {
   return html;
 }
 
-Result<std::string> ReportHtml(const ReportContent& content, const fs::path& figures_dir) {
+Result<std::string> ReportHtml(const ReportContent& content, const fs::path& dir) {
+  const fs::path figures_dir = dir / "figures";
   std::string html =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>liftoff report</title>\n<style>body{font-family:sans-serif;max-width:1250px;"
       "margin:auto}table{border-collapse:collapse}td,th{border:1px solid #999;padding:2px 8px;"
-      "text-align:right}img{max-width:100%}</style>\n</head>\n<body>\n<h1>liftoff report</h1>\n<ul>\n";
+      "text-align:right}img{max-width:100%}.evidence{display:flex;gap:8px;align-items:flex-start}"
+      ".evidence figure{flex:1;margin:4px 0}</style>\n</head>\n<body>\n<h1>liftoff report</h1>\n<ul>\n";
   for (const auto& [label, value] : Provenance(content)) {
     html += "<li>" + label + ": " + EscapeMarkup(value) + "</li>\n";
   }
@@ -494,23 +346,15 @@ Result<std::string> ReportHtml(const ReportContent& content, const fs::path& fig
   if (!content.drawn.ok()) html += "<p>Not drawn: " + EscapeMarkup(content.drawn.ToString()) + "</p>\n";
   for (const Figure& figure : content.figures) {
     if (!content.drawn.ok()) continue;
-    LIFTOFF_ASSIGN_OR_RETURN(const std::string png, ReadWholeFile(figures_dir / (figure.name + ".png")));
-    html += "<figure><img alt=\"" + EscapeMarkup(figure.title) + "\" src=\"data:image/png;base64," +
-            Base64(png) + "\"><figcaption>" + EscapeMarkup(figure.title) + "</figcaption></figure>\n";
+    LIFTOFF_ASSIGN_OR_RETURN(const std::string img,
+                             InlinePng(figures_dir / (figure.name + ".png"), figure.title));
+    html += "<figure>" + img + "<figcaption>" + EscapeMarkup(figure.title) +
+            "</figcaption></figure>\n";
   }
   if (content.calibration) html += CalibrationHtml(*content.calibration);
-  html += "<h2>Trials</h2>\n<ul>\n";
-  const auto& outcomes = content.campaign->analysis.outcomes;
-  for (size_t i = 0; i < outcomes.size(); ++i) {
-    html += "<li>" + EscapeMarkup(outcomes[i].trial.id) + " (foot " +
-            std::string(FootName(outcomes[i].trial.foot)) + "): " +
-            EscapeMarkup(TrialStatus(outcomes[i]));
-    if (!content.campaign->notes[i].empty()) html += "<ul>";
-    for (const std::string& note : content.campaign->notes[i]) html += "<li>" + EscapeMarkup(note) + "</li>";
-    if (!content.campaign->notes[i].empty()) html += "</ul>";
-    html += "</li>\n";
-  }
-  return html + "</ul>\n</body>\n</html>\n";
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string trials,
+                           TrialsHtml(*content.campaign, content.evidence, content.drawn.ok(), dir));
+  return html + trials + "</body>\n</html>\n";
 }
 
 // ---------------------------------------------------------------------------------------
@@ -530,28 +374,31 @@ Status WriteTables(const ReportContent& content, const fs::path& dir) {
       stats::RenderTrialTable(*content.values, stats::TableFormat::kCsv, calibration, rule));
 }
 
-Status WriteFiguresAndPages(ReportContent& content) {
+Status WriteFiguresAndPages(ReportContent& content, std::ostream& err) {
   const fs::path& dir = content.command->output_dir;
   const fs::path figures_dir = dir / "figures";
   content.figures.push_back(
-      TrialsFigure(*content.values, content.sim ? &content.sim->results : nullptr));
+      TrialsFigure("trials", *content.values, content.sim ? &content.sim->results : nullptr));
   if (content.sim) {
     if (auto figure7 = Figure7(content.sim->curves, *content.table)) {
       content.figures.push_back(std::move(*figure7));
     }
   }
   if (content.calibration) {
-    for (ReportFigure& figure : CalibrationFigures(*content.calibration)) {
-      content.figures.push_back({figure.name, figure.title, figure.data, figure.body});
+    for (Figure& figure : CalibrationFigures(*content.calibration)) {
+      content.figures.push_back(std::move(figure));
     }
     LIFTOFF_RETURN_IF_ERROR(WriteCalibrationFiles(*content.calibration, dir));
   }
   for (const Figure& figure : content.figures) {
     LIFTOFF_RETURN_IF_ERROR(WriteFigure(figure, figures_dir, content.command->gnuplot, content.drawn));
   }
+  LIFTOFF_ASSIGN_OR_RETURN(
+      content.evidence,
+      WriteTrialEvidence(*content.campaign, dir, content.command->gnuplot, content.drawn, err));
   LIFTOFF_RETURN_IF_ERROR(WriteTables(content, dir));
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(dir / "report.md", ReportMarkdown(content)));
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string html, ReportHtml(content, figures_dir));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string html, ReportHtml(content, dir));
   return WriteFileAtomically(dir / "report.html", html);
 }
 
@@ -638,7 +485,7 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
   content.table = &table;
   content.sim = sim ? &*sim : nullptr;
   content.calibration = calibration ? &*calibration : nullptr;
-  const Status written = WriteFiguresAndPages(content);
+  const Status written = WriteFiguresAndPages(content, err);
   if (!written.ok()) return ReportError(written, err);
   if (!content.drawn.ok()) err << "warning: figures: " << content.drawn.ToString() << '\n';
   PrintSummary(content, out);

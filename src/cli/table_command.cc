@@ -9,11 +9,11 @@
 
 #include "cli_common.h"
 #include "liftoff/capture/laika2018.h"
+#include "liftoff/cli/figures.h"
 #include "liftoff/cli/video_commands.h"
 #include "liftoff/core/output.h"
 #include "liftoff/core/file.h"
 #include "liftoff/core/json.h"
-#include "liftoff/stats/plot.h"
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
 #include "liftoff/sync/trial_analysis.h"
@@ -35,16 +35,55 @@ int Emit(const std::string& text, const std::filesystem::path& output_path, std:
   return kExitOk;
 }
 
-// what `table` writes: the tables, the plot, a verification image per trial with a video
+// the ids of the manifest's trials, in order
+std::vector<std::string> TrialIds(const TrialManifest& manifest) {
+  std::vector<std::string> ids;
+  for (const TrialRecord& trial : manifest.trials) ids.push_back(trial.id);
+  return ids;
+}
+
+// the plot's files: FILE's stem with .dat, .gp, .png and .svg, beside FILE
+std::string PlotName(const std::filesystem::path& plot_path) {
+  return plot_path.stem().string();
+}
+
+// what `table` writes: the tables, the plot's files, a verification image per trial with a
+// video
 std::vector<NamedPath> TableOutputs(const TableCommand& command, const TrialManifest& manifest) {
-  std::vector<NamedPath> outputs = {{"--output", command.output_path},
-                                    {"--plot", command.plot_path}};
+  std::vector<NamedPath> outputs = {{"--output", command.output_path}};
+  if (!command.plot_path.empty()) {
+    for (std::filesystem::path& file :
+         FigureFiles(command.plot_path.parent_path(), PlotName(command.plot_path))) {
+      outputs.push_back({"--plot", std::move(file)});
+    }
+  }
   if (command.verify_dir.empty()) return outputs;
-  for (const TrialRecord& trial : manifest.trials) {
-    if (!trial.video_path) continue;
-    outputs.push_back({"--verify-dir", TrialVerificationPath(command.verify_dir, trial.id)});
+  const std::vector<std::string> stems = TrialFileStems(TrialIds(manifest));
+  for (size_t i = 0; i < manifest.trials.size(); ++i) {
+    if (!manifest.trials[i].video_path) continue;
+    outputs.push_back({"--verify-dir", command.verify_dir / (stems[i] + ".png")});
   }
   return outputs;
+}
+
+// The per-trial figure (figures.h, TrialsFigure) as FILE's stem .dat, .gp, .png and .svg
+// beside FILE. Errors: a file that cannot be written; gnuplot missing or failing (the
+// script and data are written).
+Status WritePlot(const TableCommand& command, const std::vector<stats::TrialValue>& values,
+                 const stats::SimResults* sim, std::ostream& err) {
+  const std::filesystem::path dir = command.plot_path.parent_path();
+  const std::string name = PlotName(command.plot_path);
+  Status drawn;
+  LIFTOFF_RETURN_IF_ERROR(WriteFigure(TrialsFigure(name, values, sim),
+                                      dir.empty() ? std::filesystem::path(".") : dir,
+                                      command.gnuplot, drawn));
+  if (!drawn.ok()) {
+    return Status(drawn.code(), "--plot: " + drawn.message() + " (the script and data are in " +
+                                    (dir / (name + ".gp")).string() + ")");
+  }
+  err << "wrote " << (dir / (name + ".svg")).string() << " and .png (script " << name
+      << ".gp, data " << name << ".dat)\n";
+  return Status::Ok();
 }
 
 // what `table` reads: the manifest (or the 2018 folder's times), the calibration, the
@@ -137,6 +176,15 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
                                             command.tables + "\""),
                        err);
   }
+  if (!command.plot_path.empty()) {
+    const std::string extension = command.plot_path.extension().string();
+    const std::string name = PlotName(command.plot_path);
+    if ((extension != ".svg" && extension != ".png") || name.empty() || name.front() == '.') {
+      return ReportError(InvalidArgumentError("--plot: expected FILE.svg or FILE.png, got \"" +
+                                              command.plot_path.string() + "\""),
+                         err);
+    }
+  }
   std::optional<stats::SimResults> sim = command.sim_results;
   if (!sim && !command.sim_path.empty()) {
     auto loaded = stats::LoadSimResults(command.sim_path);
@@ -176,12 +224,13 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   if (emitted != kExitOk) return emitted;
   Status verified;
   if (!command.verify_dir.empty()) {
-    verified = WriteTrialVerifications(analysis, command.verify_dir, err);
+    const TrialVerifications written = WriteTrialVerifications(
+        analysis, TrialFileStems(TrialIds(campaign->manifest)), command.verify_dir, err);
+    for (const std::string& line : written.written) err << "wrote " << line << '\n';
+    verified = written.first_failure;
   }
   if (!command.plot_path.empty() && verified.ok()) {
-    auto plot = stats::RenderResultsPlotSvg(table);
-    verified = plot.ok() ? WriteFileAtomically(command.plot_path, *plot) : plot.status();
-    if (verified.ok()) err << "wrote " << command.plot_path.string() << '\n';
+    verified = WritePlot(command, values, sim ? &*sim : nullptr, err);
   }
 
   if (!first_failure.ok()) {
@@ -206,7 +255,10 @@ Subcommand AddTableCommand(CLI::App& parent) {
   app->add_option("--sim", command->sim_path, "Simulation results JSON for the sim columns");
   app->add_option("--output,-o", command->output_path, "Write here instead of stdout");
   app->add_option("--plot", command->plot_path,
-                  "Write the hardware-vs-simulation plot here (SVG)");
+                  "Draw each trial's liftoff rotation beside the simulation with gnuplot: "
+                  "FILE.svg and FILE.png, its script FILE.gp and data FILE.dat beside them");
+  app->add_option("--gnuplot", command->gnuplot, "The gnuplot program (for --plot)")
+      ->capture_default_str();
   app->add_option("--verify-dir", command->verify_dir,
                   "Write a verification image per video-analysed trial here (<id>.png)");
   app->add_option("--progress", command->progress,

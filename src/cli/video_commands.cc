@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 #include <ostream>
+#include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -100,18 +101,6 @@ void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
         << '\n';
   }
   for (const std::string& warning : analysis.warnings) out << "warning: " << warning << '\n';
-}
-
-// file names from trial ids: anything but letters, digits, '.', '_' and '-' becomes '_'
-std::string FileStem(const std::string& id) {
-  std::string stem = id.empty() ? std::string("trial") : id;
-  for (char& c : stem) {
-    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                      c == '.' || c == '_' || c == '-';
-    if (!keep) c = '_';
-  }
-  if (stem.front() == '.') stem.front() = '_';
-  return stem;
 }
 
 }  // namespace
@@ -259,28 +248,66 @@ int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) 
 // ---------------------------------------------------------------------------------------
 // liftoff table's verification images
 
-std::filesystem::path TrialVerificationPath(const std::filesystem::path& dir,
-                                           const std::string& trial_id) {
-  return dir / (FileStem(trial_id) + ".png");
+namespace {
+
+// a trial id as a file name: anything but letters, digits, '.', '_' and '-' becomes '_'
+std::string SafeFileStem(const std::string& id) {
+  std::string stem = id.empty() ? std::string("trial") : id;
+  for (char& c : stem) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '_' || c == '-';
+    if (!keep) c = '_';
+  }
+  if (stem.front() == '.') stem.front() = '_';
+  return stem;
 }
 
-Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
-                               const std::filesystem::path& dir, std::ostream& err) {
-  Status first_failure;
-  for (const sync::TrialOutcome& outcome : analysis.outcomes) {
+std::string Lowercase(std::string text) {
+  for (char& c : text) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return text;
+}
+
+}  // namespace
+
+std::vector<std::string> TrialFileStems(const std::vector<std::string>& trial_ids) {
+  std::vector<std::string> stems;
+  std::set<std::string> taken;  // lowercase: unique on file systems that ignore case
+  for (const std::string& id : trial_ids) {
+    const std::string safe = SafeFileStem(id);
+    std::string stem = safe;
+    for (int suffix = 2; !taken.insert(Lowercase(stem)).second; ++suffix) {
+      stem = safe + "-" + std::to_string(suffix);
+    }
+    stems.push_back(std::move(stem));
+  }
+  return stems;
+}
+
+TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
+                                           const std::vector<std::string>& stems,
+                                           const std::filesystem::path& dir, std::ostream& err) {
+  TrialVerifications result;
+  result.image_paths.resize(analysis.outcomes.size());
+  result.errors.resize(analysis.outcomes.size());
+  for (size_t i = 0; i < analysis.outcomes.size() && i < stems.size(); ++i) {
+    const sync::TrialOutcome& outcome = analysis.outcomes[i];
     if (!outcome.video) continue;
     video::VerificationOptions options;
-    options.image_path = TrialVerificationPath(dir, outcome.trial.id);
+    options.image_path = dir / (stems[i] + ".png");
     auto written = video::WriteVerification(*outcome.video, options);
     if (!written.ok()) {
       const Status failure = written.status().WithContext(outcome.trial.id);
       err << "error: " << failure.ToString() << '\n';
-      if (first_failure.ok()) first_failure = failure;
+      result.errors[i] = failure;
+      if (result.first_failure.ok()) result.first_failure = failure;
       continue;
     }
-    err << "wrote " << written->Brief() << '\n';
+    result.image_paths[i] = options.image_path;
+    result.written.push_back(written->Brief());
   }
-  return first_failure;
+  return result;
 }
 
 // ---------------------------------------------------------------------------------------

@@ -303,6 +303,10 @@ struct LedDetector::Impl {
   std::vector<float> corrected;  // ROI pixels x ring
   std::vector<double> pixel_steps, channel_steps, lit_peaks, pixel_wobble;
   std::vector<double> dating_series;
+  // with an ROI: every frame's time and the ROI's mean brightness (the trace in LedResult)
+  double roi_mean_levels = 0.0;
+  std::vector<int64_t> trace_t_ns;
+  std::vector<double> trace_brightness_levels;
 
   // per cell and region: the flicker reference, the usual frame-to-frame change, the level
   std::vector<float> cell_reference;
@@ -693,10 +697,13 @@ double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gai
   MeasureRowGains(picture, strip, gain, gains);
   const auto width = static_cast<size_t>(roi.width);
   const uint8_t* pixel = picture;
+  uint64_t total = 0;  // B + G + R over the ROI, for the trace
   for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
-    changes[i] =
-        static_cast<float>(pixel[0] + pixel[1] + pixel[2]) - gains[i / width] * pixel_reference[i];
+    const int brightness = pixel[0] + pixel[1] + pixel[2];
+    total += static_cast<uint64_t>(brightness);
+    changes[i] = static_cast<float>(brightness) - gains[i / width] * pixel_reference[i];
   }
+  roi_mean_levels = static_cast<double>(total) / (3.0 * static_cast<double>(changes.size()));
   const auto top = static_cast<std::ptrdiff_t>(top_pixels);
   std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end(), std::greater<>());
   double signal = std::accumulate(changes.begin(), changes.begin() + top, 0.0);
@@ -1095,6 +1102,10 @@ Status LedDetector::Impl::Process(const Frame& frame) {
   ring_index[slot] = frame.index;
   ring_t_ns[slot] = frame.t_ns;
   Measure(frame, slot);
+  if (!located) {
+    trace_t_ns.push_back(frame.t_ns);
+    trace_brightness_levels.push_back(roi_mean_levels);
+  }
   Confirm(slot);
   ++frames;
   if (frames >= ring) Evaluate();
@@ -1246,6 +1257,8 @@ Result<LedResult> LedDetector::Impl::Finish() const {
   }
   LedResult result;
   result.roi_located = located;
+  result.trace_t_ns = trace_t_ns;
+  result.trace_brightness_levels = trace_brightness_levels;
   bool first_rise_seen = false;
   bool already_on = false;
   for (const StepEvent* step : steps) {

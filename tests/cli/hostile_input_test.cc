@@ -131,7 +131,13 @@ const std::vector<HostileCase>& Cases() {
       {"table -o the log by another spelling", OneTrial,
        "table @/manifest.json -o @/./sub/../A1.csv", 3, {"trial A1's log"}},
       {"table --plot its manifest", OneTrial, "table @/manifest.json --plot @/manifest.json", 3,
-       {"--plot", "MANIFEST"}},
+       {"--plot", "expected FILE.svg or FILE.png", "manifest.json"}},
+      {"table --plot beside it onto its manifest",
+       [](const ScratchDir& s) {
+         OneTrial(s);
+         fs::copy_file(s / "manifest.json", s / "plot.svg");
+       },
+       "table @/plot.svg --plot @/plot.png", 3, {"--plot", "MANIFEST"}},
       {"table -o its calibration",
        [](const ScratchDir& s) {
          OneTrial(s);

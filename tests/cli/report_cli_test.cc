@@ -1,7 +1,8 @@
 // `liftoff report` end to end on the sample trials (hand times with known answers) and a
 // small simulated sweep: the table against the truth, the figures' scripts, data and
 // images, the cache, the pages' links, a failing trial and an output folder holding an
-// input.
+// input; on a synthetic clip, each video trial's traces figure and verification image.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -16,7 +17,9 @@
 
 #include "liftoff/cli/report_command.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/time.h"
 #include "support/test_support.h"
+#include "video_campaign.h"
 
 namespace liftoff::cli {
 namespace {
@@ -233,6 +236,88 @@ TEST(CliReport, SampleCampaignTableFiguresAndPages) {
   const CommandRun rerun = RunReportCommand(other);
   ASSERT_EQ(rerun.code, kExitOk) << rerun.err;
   EXPECT_THAT(rerun.out, HasSubstr("ran and cached in"));
+}
+
+// the rows of a traces figure's block 0: name -> (t_s, lower_s, upper_s)
+std::map<std::string, std::vector<double>> Instants(const std::string& data) {
+  std::map<std::string, std::vector<double>> instants;
+  std::istringstream lines(data.substr(0, data.find("\n\n")));
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name;
+    double t_s = 0, lower_s = 0, upper_s = 0;
+    fields >> name >> t_s >> lower_s >> upper_s;
+    instants[name] = {t_s, lower_s, upper_s};
+  }
+  return instants;
+}
+
+TEST(CliReport, VideoTrialsGetTheirTracesAndVerificationImages) {
+  ScratchDir scratch;
+  const VideoCampaign campaign = WriteVideoCampaign(scratch / "campaign", 1);
+  ASSERT_TRUE(campaign.error.empty()) << campaign.error;
+  ReportCommand command;
+  command.manifest_path = campaign.manifest_path;
+  command.output_dir = scratch / "report";
+  command.no_sim = true;
+  command.sweep.experiment.progress = "off";
+  const CommandRun run = RunReportCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("report: 3 trials, 0 failed"));
+  const fs::path& dir = command.output_dir;
+
+  // "clip/1" and "clip_1" make the same safe name: the second gets "-2"
+  const synth::GroundTruth& truth = campaign.trial.truth;
+  const double frame_s = SecondsFromNs(truth.frame_times_ns[1] - truth.frame_times_ns[0]);
+  for (const std::string stem : {"clip_1", "clip_1-2"}) {
+    SCOPED_TRACE(stem);
+    const fs::path figure = dir / "figures" / ("trial-" + stem);
+    ASSERT_TRUE(fs::exists(figure.string() + ".gp"));
+    const std::string data = ReadFile(figure.string() + ".dat");
+    // the detected instants against the renderer's truth: the LED within half a frame,
+    // the 1 mm liftoff within three, each interval around its instant
+    const auto instants = Instants(data);
+    ASSERT_EQ(instants.count("led_on"), 1u) << data.substr(0, 600);
+    ASSERT_EQ(instants.count("liftoff"), 1u);
+    ASSERT_EQ(instants.count("onset"), 1u);
+    EXPECT_NEAR(instants.at("led_on")[0], SecondsFromNs(*truth.led_on_video_ns), frame_s / 2);
+    EXPECT_NEAR(instants.at("liftoff")[0], SecondsFromNs(*truth.liftoff_1mm_video_ns),
+                3 * frame_s);
+    EXPECT_LT(instants.at("onset")[0], instants.at("liftoff")[0]);
+    for (const auto& [name, instant] : instants) {
+      EXPECT_LE(instant[1], instant[0]) << name;
+      EXPECT_GE(instant[2], instant[0]) << name;
+    }
+    // both traces, one row a frame
+    EXPECT_THAT(data, HasSubstr("t_s brightness_levels"));
+    EXPECT_THAT(data, HasSubstr("t_s height_mm"));
+    EXPECT_GE(static_cast<size_t>(std::count(data.begin(), data.end(), '\n')),
+              2 * truth.frame_times_ns.size());
+    ExpectValidPng(dir / "trials" / (stem + ".png"));
+    if (GnuplotOnPath()) {
+      ExpectValidPng(figure.string() + ".png");
+      ExpectValidSvg(figure.string() + ".svg");
+    }
+  }
+
+  // the pages: the images linked (Markdown) and inline (HTML); the hand trial says why
+  // it has none
+  const std::string markdown = ReadFile(dir / "report.md");
+  EXPECT_THAT(markdown, HasSubstr("verification image: [trials/clip_1.png](trials/clip_1.png)"));
+  EXPECT_THAT(markdown, HasSubstr("verification image: [trials/clip_1-2.png](trials/clip_1-2.png)"));
+  EXPECT_THAT(markdown, HasSubstr("no traces figure: times given by hand"));
+  // the trials figure's image, script and data; each clip's traces image, script, data and
+  // its verification image
+  ExpectLinksResolve(dir / "report.md", "](", ')', GnuplotOnPath() ? 11 : 8);
+  const std::string html = ReadFile(dir / "report.html");
+  EXPECT_EQ(Targets(html, "alt=\"verification image\" src=\"data:image/png;base64,", '"').size(),
+            2u);
+  if (GnuplotOnPath()) {
+    EXPECT_EQ(Targets(html, "alt=\"trial clip", '"').size(), 2u) << "both traces inline";
+  } else {
+    std::cout << "[  SKIPPED ] traces PNG/SVG checks: gnuplot is not on the PATH\n";
+  }
 }
 
 TEST(CliReport, FailingTrialIsReportedAndLeftOut) {

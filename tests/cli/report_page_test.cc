@@ -1,4 +1,5 @@
-// The report's HTML page in a real browser: `liftoff report` on the sample trials, then
+// The report's HTML page in a real browser: `liftoff report` on the sample trials and a
+// synthetic clip (entered twice: two traces figures, two verification images), then
 // headless Chromium (Debian's `chromium`) opens report.html offline. A copy of the page
 // with a probe script appended reports in its title how many of its figures decoded; a
 // second copy with every figure's data broken checks that the probe sees a broken one.
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "support/test_support.h"
+#include "video_campaign.h"
 
 namespace liftoff::cli {
 namespace {
@@ -23,7 +25,6 @@ using liftoff::testing::Quoted;
 using liftoff::testing::ReadFile;
 using liftoff::testing::RunCommand;
 using liftoff::testing::ScratchDir;
-using liftoff::testing::SourceDir;
 using liftoff::testing::WriteFile;
 
 // Chromium on PATH, or empty
@@ -83,16 +84,21 @@ TEST(ReportPage, OpensOfflineInChromiumWithEveryFigureLoaded) {
                     "not checked in a browser";
   }
   ScratchDir scratch;
+  const VideoCampaign campaign = WriteVideoCampaign(scratch / "campaign", 8);
+  ASSERT_TRUE(campaign.error.empty()) << campaign.error;
   const fs::path out = scratch / "report";
   const CommandRun report =
       RunCommand(LIFTOFF_BINARY,
-                 "report " + Quoted(SourceDir() / "samples" / "trials" / "manifest.json") +
-                     " -o " + Quoted(out) + " --tensions mean,high --progress off",
+                 "report " + Quoted(campaign.manifest_path) + " -o " + Quoted(out) +
+                     " --tensions mean,high --progress off",
                  scratch);
   ASSERT_EQ(report.code, 0) << report.err;
   const std::string page = ReadFile(out / "report.html");
   const int figures = CountOf(page, "<img ");
-  ASSERT_GE(figures, 2) << "the page holds the trials and Figure 7 at least";
+  // the trials, Figure 7, the fit and the Monte Carlo; each clip's traces and verification
+  EXPECT_EQ(CountOf(page, "<img alt=\"verification image\""), 2);
+  EXPECT_EQ(CountOf(page, "<img alt=\"trial clip"), 2);
+  ASSERT_GE(figures, 6) << "the page holds the trials, Figure 7 and each clip's evidence at least";
   EXPECT_EQ(CountOf(page, "src=\"data:image/png;base64,"), figures) << "every figure inline";
 
   const fs::path probed = out / "probed.html";

@@ -170,6 +170,24 @@ TEST(LedDetector, ReportsEveryPulseWithItsOnAndOffInstants) {
                     close_ns);
       }
       EXPECT_EQ(result->roi_located, located);
+      // the brightness trace, with an ROI: every frame at its time, dark, lit, and the
+      // partly lit frame 12 (51 %) about half way between
+      if (located) {
+        EXPECT_TRUE(result->trace_t_ns.empty());
+        EXPECT_TRUE(result->trace_brightness_levels.empty());
+        continue;
+      }
+      ASSERT_EQ(result->trace_t_ns.size(), frames.size());
+      ASSERT_EQ(result->trace_brightness_levels.size(), frames.size());
+      for (size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_EQ(result->trace_t_ns[i], frames[i].t_ns) << "frame " << i;
+      }
+      const std::vector<double>& levels = result->trace_brightness_levels;
+      const double off = result->off_level, contrast = result->on_level - result->off_level;
+      ASSERT_GT(contrast, 10.0);
+      EXPECT_NEAR(levels[5], off, 0.05 * contrast);
+      EXPECT_NEAR(levels[20], result->on_level, 0.05 * contrast);
+      EXPECT_NEAR((levels[12] - off) / contrast, 0.508, 0.05);
     }
   }
 }

@@ -67,8 +67,12 @@ struct TableCommand {
   std::optional<stats::SimResults> sim_results;
   /// Write the tables here instead of `out`.
   std::filesystem::path output_path;
-  /// The per-foot hardware-vs-simulation plot (SVG) to write; empty: none.
+  /// The per-trial figure (liftoff rotation with its interval beside the simulation) drawn
+  /// by gnuplot: its stem .svg, .png, .gp (script) and .dat (data) beside this path; empty:
+  /// none.
   std::filesystem::path plot_path;
+  /// The gnuplot program (found on the PATH unless a path is given).
+  std::string gnuplot = "gnuplot";
   /// Trials whose times come from their video: write <dir>/<trial id>.png, a verification
   /// image, for each; empty: none.
   std::filesystem::path verify_dir;

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/progress_line.h"
@@ -63,16 +64,30 @@ Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::pa
                                                        const video::ClipAnalysisOptions& options,
                                                        VideoProgress& progress);
 
-/// The verification image of a trial: `dir`/<trial id>.png, the id made a safe file name
-/// (anything but letters, digits, '.', '_' and '-' becomes '_').
-std::filesystem::path TrialVerificationPath(const std::filesystem::path& dir,
-                                           const std::string& trial_id);
+/// File stems for trial ids, in order: each id made a safe file name (anything but letters,
+/// digits, '.', '_' and '-' becomes '_'; a leading '.' too; an empty id is "trial"), and
+/// unique even where the file system ignores case: a stem that would clash with an earlier
+/// one gets "-2", "-3", ... ("a/1" and "a_1" become "a_1" and "a_1-2").
+std::vector<std::string> TrialFileStems(const std::vector<std::string>& trial_ids);
 
-/// Writes `dir`/<trial id>.png for every trial of `analysis` whose times came from its
-/// video (failed ones included, when their video analysis got through); one line per file
-/// on `err`. Returns the first error; the other images are still written.
-Status WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
-                               const std::filesystem::path& dir, std::ostream& err);
+/// What WriteTrialVerifications wrote.
+struct TrialVerifications {
+  /// Per outcome, in order: the image written, or empty (no video analysis, or it failed).
+  std::vector<std::filesystem::path> image_paths;
+  /// Per outcome: why its image failed (OK when written or not asked for).
+  std::vector<Status> errors;
+  /// One line per image written (VerificationReport::Brief()).
+  std::vector<std::string> written;
+  /// The first error (OK when none); the other images are still written.
+  Status first_failure;
+};
+
+/// Writes `dir`/<stem>.png for every trial of `analysis` whose times came from its video
+/// (failed ones included, when their video analysis got through), `stems` one per outcome
+/// (TrialFileStems of their ids). Each error goes to `err` as it happens.
+TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysis,
+                                           const std::vector<std::string>& stems,
+                                           const std::filesystem::path& dir, std::ostream& err);
 
 /// The command added to the command line `parent` (flags bound to its struct).
 Subcommand AddVideoCommand(CLI::App& parent);

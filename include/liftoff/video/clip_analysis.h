@@ -3,7 +3,8 @@
 // instants are found. Frames are decoded on one thread and analysed on the calling thread
 // through a small queue of reused buffers, so the analysis costs little more than the
 // decoding, and memory stays flat in the clip's length: no frame is kept, only the foot
-// tracker's 40 bytes and 8 bytes of frame time per frame. Method and parameters:
+// tracker's 40 bytes, 8 bytes of frame time and, with an LED region, the LED's 16 bytes of
+// brightness trace per frame. Method and parameters:
 // docs/video.md.
 //
 // The rest window rule (the foot's rest height is its mean over it): by default the 0.5 s

@@ -97,6 +97,13 @@ struct LedResult {
   double contrast_levels = 0.0;
   /// Every switch-on in the clip, in order (at least one: Finish fails otherwise).
   std::vector<LedPulse> pulses;
+  /// The LED's brightness trace, with a given ROI: every frame's time (Frame::t_ns, video
+  /// clock, ns) and the ROI's mean brightness that frame, grey levels 0..255 (mean of B, G
+  /// and R, as off_level and on_level), in decode order (16 bytes a frame). Empty when the
+  /// LED was located automatically: its region is known only at the end, and no frame is
+  /// kept.
+  std::vector<int64_t> trace_t_ns;
+  std::vector<double> trace_brightness_levels;
   /// For people: "LED dim: on-off contrast 9 grey levels (expected >= 20)", "LED already
   /// on in the first frame: the first switch-on may have been missed", ...
   std::vector<std::string> warnings;
@@ -105,9 +112,9 @@ struct LedResult {
   std::string Brief() const;
 };
 
-/// Streams frames in decode order; memory stays flat in the clip's length (with an ROI, its
-/// last 5 + min_on_frames pictures; the automatic locator keeps O(1) state per image cell,
-/// never frames).
+/// Streams frames in decode order; no frame is kept (with an ROI, its last 5 +
+/// min_on_frames pictures and the 16-byte trace entry per frame; the automatic locator
+/// keeps O(1) state per image cell, never frames).
 class LedDetector {
  public:
   struct Options {
