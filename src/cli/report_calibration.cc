@@ -208,6 +208,10 @@ std::string FitMarkdown(const ReportCalibration& calibration, const ReportComman
           " (bootstrap over each foot's trials, " + std::to_string(command.fit.bootstrap_samples) +
           " resamples, seed " + std::to_string(command.fit.seed) + "; 95 % [" +
           Signed(fitted.sigma_low95, 3) + ", " + Signed(fitted.sigma_high95, 3) + "])\n";
+  text += "- systematic +- " + FormatFixed(fitted.sigma_systematic, 3) +
+          ": the move of the fit when every trial shifts together by its foot's median "
+          "measurement uncertainty (a bias the trials share, which the bootstrap cannot see); "
+          "with the bootstrap, +- " + FormatFixed(fitted.sigma_total, 3) + " in all\n";
   text += "- stiffnesses: silicone " + FormatFixed(tension.silicone_n_per_m, 1) + " N/m, Buna-N " +
           FormatFixed(tension.buna_n_n_per_m, 1) + " N/m, spring " +
           FormatFixed(tension.spring_n_per_m, 1) + " N/m (`liftoff sim run --stiffness " +
@@ -224,15 +228,16 @@ std::string FitMarkdown(const ReportCalibration& calibration, const ReportComman
           FormatNumber(command.fit.sigma_step) +
           "; between those points the liftoff rotation is interpolated linearly)\n\n";
   text +=
-      "| foot | trials | hardware mean | standard error | sim at the fit (interpolated) | "
-      "sim at the fit (run) | z |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+      "| foot | trials | hardware mean | standard error | measurement uncertainty | "
+      "sim at the fit (interpolated) | sim at the fit (run) | z |\n"
+      "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (size_t f = 0; f < fitted.feet.size(); ++f) {
     const fit::FootTarget& target = calibration.targets[f];
     const double run = AtFitRad(calibration, target.foot);
     text += "| " + std::string(FootName(target.foot)) + " | " + std::to_string(target.summary.n) +
             " | " + FormatFixed(target.summary.mean, 3) + " | " +
             FormatFixed(target.standard_error_rad, 4) + " | " +
-            FormatFixed(*fitted.feet[f].sim_rad, 3) + " | " +
+            FormatFixed(target.measurement_rad, 4) + " | " + FormatFixed(*fitted.feet[f].sim_rad, 3) + " | " +
             (std::isfinite(run) ? FormatFixed(run, 3) : std::string("no value")) + " | " +
             Signed(fitted.feet[f].z, 1) + " |\n";
   }

@@ -215,6 +215,23 @@ Status TargetOptions::Validate() const {
   return Status::Ok();
 }
 
+namespace {
+
+// The median half-width of `foot`'s finite trials' uncertainty intervals, rad; 0 for none.
+double MedianHalfWidth(const std::vector<stats::TrialValue>& values, Foot foot) {
+  std::vector<double> half_widths;
+  for (const stats::TrialValue& value : values) {
+    const double half_width = 0.5 * (value.upper_rad - value.lower_rad);
+    if (value.foot == foot && std::isfinite(value.liftoff_rad) && std::isfinite(half_width)) {
+      half_widths.push_back(half_width);
+    }
+  }
+  if (half_widths.empty()) return 0.0;
+  return stats::Summarize(half_widths).median;
+}
+
+}  // namespace
+
 Result<std::vector<FootTarget>> TargetsFromTrials(const std::vector<stats::TrialValue>& values,
                                                   const TargetOptions& options,
                                                   std::vector<std::string>* skipped) {
@@ -236,6 +253,7 @@ Result<std::vector<FootTarget>> TargetsFromTrials(const std::vector<stats::Trial
       continue;
     }
     target.summary = stats::Summarize(target.liftoff_rad);
+    target.measurement_rad = MedianHalfWidth(values, foot);
     target.standard_error_rad =
         std::max(target.summary.stddev / std::sqrt(static_cast<double>(target.summary.n)),
                  options.standard_error_floor_rad);
@@ -416,10 +434,29 @@ std::vector<TensionPoint> GridTensionPoints(const std::vector<TensionPoint>& poi
 
 std::string TensionFit::Brief() const {
   return "sigma " + FormatFixed(sigma, 2) + " +- " + FormatFixed(sigma_stddev, 2) + " (95 % [" +
-         FormatFixed(sigma_low95, 2) + ", " + FormatFixed(sigma_high95, 2) + "]), chi2/dof " +
+         FormatFixed(sigma_low95, 2) + ", " + FormatFixed(sigma_high95, 2) + "]), +- " +
+         FormatFixed(sigma_systematic, 2) + " systematic, chi2/dof " +
          (std::isfinite(chi_square_per_dof) ? FormatFixed(chi_square_per_dof, 1) : "n/a") +
          (poor ? " (poor)" : "");
 }
+
+namespace {
+
+// The larger move of the fitted sigma when every foot's mean shifts by +measurement_rad,
+// or every one by -measurement_rad (a bias the trials share).
+double SystematicSigma(const Curves& curves, const std::vector<double>& means,
+                       const std::vector<double>& errors, const std::vector<FootTarget>& targets,
+                       double sigma) {
+  double largest = 0.0;
+  for (const double sign : {1.0, -1.0}) {
+    std::vector<double> shifted = means;
+    for (size_t f = 0; f < targets.size(); ++f) shifted[f] += sign * targets[f].measurement_rad;
+    largest = std::max(largest, std::abs(FitCurves(curves, shifted, errors).sigma - sigma));
+  }
+  return largest;
+}
+
+}  // namespace
 
 Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
                               const std::vector<TensionSample>& grid,
@@ -443,6 +480,8 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
   fit.sigma_stddev = StandardDeviation(sigmas);
   fit.sigma_low95 = Quantile(sigmas, 0.025);
   fit.sigma_high95 = Quantile(sigmas, 0.975);
+  fit.sigma_systematic = SystematicSigma(curves, means, errors, targets, best.sigma);
+  fit.sigma_total = std::hypot(fit.sigma_stddev, fit.sigma_systematic);
   fit.searched_sigma_min = curves.sigma.front();
   fit.searched_sigma_max = curves.sigma.back();
   for (size_t f = 0; f < targets.size(); ++f) {

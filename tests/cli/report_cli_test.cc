@@ -369,7 +369,8 @@ TEST(CliReport, Hardware2018RanksTheHighestTensionFirstAndSaysTheFitIsPoor) {
   const CommandRun run = RunReportCommand(command);
   ASSERT_EQ(run.code, kExitOk) << run.err;
   EXPECT_THAT(run.out, HasSubstr("calibration: best tension point high (chi2 282.7); fitted sigma "
-                                 "2.50 +- 0.09 (95 % [2.25, 2.50]), chi2/dof 90.9 (poor)"));
+                                 "2.50 +- 0.09 (95 % [2.25, 2.50]), +- 0.00 systematic, "
+                                 "chi2/dof 90.9 (poor)"));
   const std::string section = ReadFile(scratch / "report" / "calibration.md");
   for (const std::string part :
        {"The highest tension point, high, ranks 1 of 5.", "- A: high, med-high, mean",

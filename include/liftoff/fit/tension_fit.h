@@ -51,6 +51,11 @@ struct FootTarget {
   stats::Summary summary;
   /// Standard error of the mean used as the foot's weight, rad (> 0).
   double standard_error_rad = 0.0;
+  /// The trials' own measurement uncertainty: the median half-width of their uncertainty
+  /// intervals, rad (0 when none has one). Averaging trials does not shrink a bias they
+  /// share (one detector, one lookup rule), so the fit takes this as a possible common
+  /// shift of every trial (TensionFit::sigma_systematic).
+  double measurement_rad = 0.0;
 };
 
 struct TargetOptions {
@@ -179,6 +184,12 @@ struct TensionFit {
   /// sigma_stddev scaled by sqrt(chi-square / dof) when that is above 1 (the spread the
   /// misfit implies; the bootstrap alone only knows the trials' spread).
   double sigma_stddev_scaled = 0.0;
+  /// What a bias shared by every trial moves the fit by: every foot's trials shifted by
+  /// +-FootTarget::measurement_rad together and refitted, the larger move of sigma (0
+  /// when the trials state no uncertainty). The bootstrap cannot see such a bias.
+  double sigma_systematic = 0.0;
+  /// sqrt(sigma_stddev^2 + sigma_systematic^2): the uncertainty to judge the fit by.
+  double sigma_total = 0.0;
   /// Each target foot at the fit (interpolated).
   std::vector<FootAgreement> feet;
   /// The contiguous range of grid sigmas where every target foot has a value, which the
@@ -189,7 +200,7 @@ struct TensionFit {
   /// foot whose hardware mean no simulated tension reaches, a poor chi-square.
   std::vector<std::string> warnings;
 
-  /// "sigma 2.31 +- 0.12 (95 % [2.10, 2.55]), chi2/dof 311.2 (poor)"
+  /// "sigma 2.31 +- 0.12 (95 % [2.10, 2.55]), +- 0.05 systematic, chi2/dof 311.2 (poor)"
   std::string Brief() const;
 };
 
