@@ -360,7 +360,8 @@ video::ClipAnalysis VideoAt(const json& j) {
   return v;
 }
 
-// one trial: its manifest index and id (the record itself is the merge's manifest's)
+}  // namespace
+
 json TrialOutcomeToJson(size_t index, const sync::TrialOutcome& outcome,
                         const std::vector<std::string>& notes) {
   return {{"index", index},
@@ -380,6 +381,8 @@ void TrialOutcomeFromJson(const json& j, sync::TrialOutcome& outcome,
   if (!j.at("video").is_null()) outcome.video = VideoAt(j.at("video"));
   notes = j.at("notes").get<std::vector<std::string>>();
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------
 // loading and checking shard files

@@ -19,11 +19,24 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "cli_common.h"
 #include "liftoff/cli/report_command.h"
 #include "liftoff/fit/tension_fit.h"
 
 namespace liftoff::cli {
+
+/// One trial in a shard file: its manifest index and id, status, measurement, log report,
+/// video analysis (all of video::ClipAnalysis, the foot's per-frame trace included) and
+/// the notes printed about it. The trial's record is not carried: the merge takes it from
+/// its own manifest.
+nlohmann::json TrialOutcomeToJson(size_t index, const sync::TrialOutcome& outcome,
+                                  const std::vector<std::string>& notes);
+/// The same back into `outcome` (its record left as it is) and `notes`; throws
+/// nlohmann::json::exception or std::out_of_range for a damaged entry.
+void TrialOutcomeFromJson(const nlohmann::json& entry, sync::TrialOutcome& outcome,
+                          std::vector<std::string>& notes);
 
 /// The command's --shard (1/1 when not given); kInvalidArgument naming the flag for a bad
 /// one, or for --shard with --merge.

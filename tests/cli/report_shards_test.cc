@@ -23,6 +23,9 @@
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/report_command.h"
 #include "liftoff/core/json.h"
+#include "liftoff/core/manifest.h"
+#include "liftoff/sync/trial_analysis.h"
+#include "report_shards.h"
 #include "support/test_support.h"
 
 #ifdef LIFTOFF_CI_SET_DIR
@@ -270,10 +273,55 @@ fs::path CiSubsetManifest(const fs::path& set_dir, const ScratchDir& scratch) {
   return path;
 }
 
-TEST(ReportShards, VideoCampaignJobsAndShardsEqualOneSerialRun) {
+// the rendered CI set's folder; empty when it is not there
+fs::path CiSetDir() {
   const char* kept = std::getenv("LIFTOFF_CI_SET_DIR");
-  const fs::path set_dir = kept != nullptr && *kept != '\0' ? fs::path(kept) : fs::path(kRenderedSetDir);
-  if (set_dir.empty() || !fs::exists(set_dir / "manifest.json")) {
+  const fs::path dir = kept != nullptr && *kept != '\0' ? fs::path(kept) : fs::path(kRenderedSetDir);
+  return !dir.empty() && fs::exists(dir / "manifest.json") ? dir : fs::path();
+}
+
+// A trial's outcome through a shard file and back is the same outcome: every field of
+// its video analysis that `liftoff video --json` shows, its measurement, its notes; and
+// written again, the same entry.
+TEST(ReportShards, TrialOutcomeSurvivesTheShardFile) {
+  const fs::path set_dir = CiSetDir();
+  if (set_dir.empty()) GTEST_SKIP() << "the synthetic CI set is not rendered (fixture ci_set)";
+  ScratchDir scratch;
+  auto manifest = LoadManifest(CiSubsetManifest(set_dir, scratch));
+  auto calibration = LoadCalibration(SourceDir() / "calib" / "laika-2018.json");
+  ASSERT_TRUE(manifest.ok() && calibration.ok());
+  for (const size_t index : {size_t{1}, size_t{3}, size_t{4}}) {  // ci-04, broken, ci-11
+    const sync::TrialOutcome outcome =
+        sync::AnalyzeManifestTrial(*manifest, *calibration, {}, index);
+    ASSERT_TRUE(outcome.video || index == 3) << outcome.status.ToString();
+    const std::vector<std::string> notes = OutcomeNotes(outcome);
+    const nlohmann::json entry = TrialOutcomeToJson(index, outcome, notes);
+    sync::TrialOutcome back;
+    back.trial = outcome.trial;
+    std::vector<std::string> back_notes;
+    TrialOutcomeFromJson(nlohmann::json::parse(entry.dump()), back, back_notes);
+    EXPECT_EQ(TrialOutcomeToJson(index, back, back_notes), entry);
+    EXPECT_EQ(back_notes, notes);
+    EXPECT_EQ(OutcomeNotes(back), notes);
+    EXPECT_EQ(back.status.ToString(), outcome.status.ToString());
+    ASSERT_EQ(back.video.has_value(), outcome.video.has_value());
+    if (outcome.video) {
+      EXPECT_EQ(back.video->ToJson(), outcome.video->ToJson());
+      ASSERT_TRUE(back.video->foot.has_value());
+      EXPECT_EQ(back.video->foot->samples.size(), outcome.video->foot->samples.size());
+      EXPECT_EQ(back.video->foot->samples.back().rise_px, outcome.video->foot->samples.back().rise_px);
+    }
+    ASSERT_EQ(back.measurement.has_value(), outcome.measurement.has_value());
+    if (outcome.measurement) {
+      EXPECT_EQ(back.measurement->liftoff_rad, outcome.measurement->liftoff_rad);
+      EXPECT_EQ(back.measurement->lookup.Brief(), outcome.measurement->lookup.Brief());
+    }
+  }
+}
+
+TEST(ReportShards, VideoCampaignJobsAndShardsEqualOneSerialRun) {
+  const fs::path set_dir = CiSetDir();
+  if (set_dir.empty()) {
     GTEST_SKIP() << "the synthetic CI set is not rendered (ctest renders it: fixture ci_set)";
   }
   ScratchDir scratch;
