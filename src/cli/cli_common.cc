@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <cstdio>
 #include <ostream>
 
 #include "liftoff/capture/laika2018.h"
@@ -150,6 +151,17 @@ int RefuseToOverwriteInputs(const std::vector<NamedPath>& outputs,
                             const std::vector<NamedPath>& inputs, std::ostream& err) {
   const Status checked = CheckOutputsAreNotInputs(outputs, inputs);
   return checked.ok() ? kExitOk : ReportError(checked, err);
+}
+
+std::string HashHex(std::string_view bytes) {
+  uint64_t hash = 14695981039346656037ULL;
+  for (const char byte : bytes) {
+    hash ^= static_cast<unsigned char>(byte);
+    hash *= 1099511628211ULL;
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
 }
 
 void PrintLogWarnings(const LogReadReport& report, std::ostream& err) {

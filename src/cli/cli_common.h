@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "campaign_analysis.h"
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/flags.h"
 #include "liftoff/core/calibration.h"
@@ -85,7 +86,10 @@ void PrintLogWarnings(const LogReadReport& report, std::ostream& err);
 struct CampaignAnalysis {
   TrialManifest manifest;
   Calibration calibration;
+  /// The trials analysed (a shard's only: CampaignRun::shard), in manifest order.
   sync::ManifestAnalysis analysis;
+  /// Per outcome, its trial's index in the manifest.
+  std::vector<size_t> trial_indices;
   /// Per outcome, in the same order: the lines printed about it ("warning: ...",
   /// "note: ...", "error: ...").
   std::vector<std::vector<std::string>> notes;
@@ -93,13 +97,28 @@ struct CampaignAnalysis {
   Status first_failure;
 };
 
+/// Loads the manifest (or 2018 folder) and the calibration (analysis.calibration and
+/// analysis.rule set), analysing no trial.
+Result<CampaignAnalysis> LoadCampaign(const std::filesystem::path& manifest_path,
+                                      const CalibrationChoice& calibration_choice,
+                                      const LookupChoice& lookup_choice, std::ostream& err);
+
 /// Loads the manifest (or 2018 folder) and the calibration, and analyses every trial
-/// (videos without times through video analysis, progress on `err` in `progress_mode`);
-/// each trial's notes go to `err` as they are found. A failing trial is a result, not an
-/// error: the error is for bad options, manifest or calibration.
+/// that `run.shard` holds, `run.jobs` at a time (videos without times through video
+/// analysis, one progress line on `err` in `run.progress`); then each trial's notes go to
+/// `err`, in manifest order. A failing trial is a result, not an error: the error is for
+/// bad options, manifest or calibration.
 Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
                                          const CalibrationChoice& calibration_choice,
-                                         const LookupChoice& lookup_choice,
-                                         std::string_view progress_mode, std::ostream& err);
+                                         const LookupChoice& lookup_choice, const CampaignRun& run,
+                                         std::ostream& err);
+
+/// The lines about one trial a person should see ("warning: ...", "note: ...", "error:
+/// ..."): log warnings, the video's brief and warnings, the failure, the lookup's notes.
+std::vector<std::string> OutcomeNotes(const sync::TrialOutcome& outcome);
+
+/// 64-bit FNV-1a of `bytes` as 16 hex digits: a stable key across machines and runs (not
+/// a security hash).
+std::string HashHex(std::string_view bytes);
 
 }  // namespace liftoff::cli

@@ -44,7 +44,9 @@ std::string FigureScript(const Figure& figure) {
 
 Status DrawFigure(const std::string& program, const fs::path& dir, const std::string& name) {
   const std::string cd = "cd '" + dir.string() + "'";
-  const std::string script = (dir / (name + ".gp")).string();
+  // the script by its name in `dir`, where gnuplot runs (a relative `dir` would not
+  // resolve after the cd)
+  const std::string script = name + ".gp";
   const std::string log = (dir / (name + ".log")).string();
   std::vector<std::string> arguments = {program, "-e", cd, script};
   std::vector<char*> argv;
@@ -65,7 +67,8 @@ Status DrawFigure(const std::string& program, const fs::path& dir, const std::st
   int wait_status = 0;
   if (waitpid(pid, &wait_status, 0) != pid || !WIFEXITED(wait_status) ||
       WEXITSTATUS(wait_status) != 0) {
-    return IoError(program + " failed on " + script + "; its messages are in " + log);
+    return IoError(program + " failed on " + (dir / script).string() + "; its messages are in " +
+                   log);
   }
   std::error_code error;
   if (fs::file_size(log, error) == 0) fs::remove(log, error);

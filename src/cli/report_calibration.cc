@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr std::string_view kCacheFormat = "liftoff-calibration-cache";
-constexpr int kCacheVersion = 1;
+constexpr int kCacheVersion = 2;  // 2: each Monte Carlo draw seeded by its index
 
 size_t FootIndex(Foot foot) { return static_cast<size_t>(foot); }
 
@@ -87,10 +87,12 @@ LoadCachedRuns(const fs::path& path, const std::string& options) {
   return std::make_pair(std::move(grid).value(), std::move(monte_carlo).value());
 }
 
-// the grid and Monte Carlo runs, from the cache or simulated (and cached)
+// the grid and Monte Carlo runs, from the cache or simulated (the Monte Carlo's taken
+// from `merged` when given) and cached
 Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibration,
                       const sim::ModelDescription& model, const sim::SweepOptions& sweep,
-                      ReportCalibration& result, std::ostream& err) {
+                      const std::vector<fit::TensionSample>* merged, ReportCalibration& result,
+                      std::ostream& err) {
   const std::string options = CacheOptions(command);
   if (auto cached = LoadCachedRuns(result.cache_path, options)) {
     result.grid = std::move(cached->first);
@@ -100,17 +102,22 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
   }
   const std::vector<TensionPoint> grid =
       fit::GridTensionPoints(calibration.tension_points, command.fit);
-  LIFTOFF_ASSIGN_OR_RETURN(const std::vector<TensionPoint> draws,
-                           fit::MonteCarloDraws(calibration, command.monte_carlo));
+  std::vector<TensionPoint> draws;
+  if (merged == nullptr) {
+    LIFTOFF_ASSIGN_OR_RETURN(draws, fit::MonteCarloDraws(calibration, command.monte_carlo));
+  }
   if (command.sweep.experiment.progress != "off") {
     err << "calibration: simulating " << Plural(static_cast<int64_t>(grid.size()), "tension scale")
         << " and " << Plural(static_cast<int64_t>(draws.size()), "Monte Carlo draw")
+        << (merged ? " (the Monte Carlo's from the shards)" : "")
         << ", each for " << sweep.feet.size() << (sweep.feet.size() == 1 ? " foot" : " feet")
         << "\n";
   }
   const auto start = std::chrono::steady_clock::now();
   LIFTOFF_ASSIGN_OR_RETURN(result.grid, fit::SimulateTensions(model, sweep, grid));
-  if (!draws.empty()) {
+  if (merged != nullptr) {
+    result.monte_carlo = *merged;
+  } else if (!draws.empty()) {
     LIFTOFF_ASSIGN_OR_RETURN(result.monte_carlo, fit::SimulateTensions(model, sweep, draws));
   }
   if (command.sweep.experiment.progress != "off") {
@@ -323,7 +330,9 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
                                             const Calibration& calibration,
                                             const std::vector<stats::TrialValue>& values,
                                             const stats::SimResults& sim,
-                                            const fs::path& cache_path, std::ostream& err) {
+                                            const fs::path& cache_path,
+                                            const std::vector<fit::TensionSample>* monte_carlo,
+                                            std::ostream& err) {
   LIFTOFF_RETURN_IF_ERROR(command.fit.Validate());
   LIFTOFF_RETURN_IF_ERROR(command.monte_carlo.Validate());
   ReportCalibration result;
@@ -336,7 +345,8 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
   LIFTOFF_ASSIGN_OR_RETURN(const sim::ModelDescription model,
                            sim::LoadModelDescription(ModelPathFrom(command.sweep.experiment)));
   LIFTOFF_ASSIGN_OR_RETURN(const sim::SweepOptions sweep, SweepOptionsFrom(command.sweep));
-  LIFTOFF_RETURN_IF_ERROR(SimulateOrLoad(command, calibration, model, sweep, result, err));
+  LIFTOFF_RETURN_IF_ERROR(
+      SimulateOrLoad(command, calibration, model, sweep, monte_carlo, result, err));
   result.distributions = fit::Distributions(result.monte_carlo);
 
   // the hardware against them

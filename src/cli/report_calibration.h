@@ -49,13 +49,16 @@ struct ReportCalibration {
 
 /// Calibrates the campaign: `values` (the trials) against the sweep's `sim` results and
 /// fresh runs for the grid and the Monte Carlo (or their cache: `cache_path`, valid while
-/// its options match). kInvalidArgument for bad fit or Monte Carlo options; a campaign
-/// that cannot be fitted is a result (fit_status), not an error.
+/// its options match). `monte_carlo`, when given, holds the Monte Carlo's simulated draws
+/// already (merged from shards: report_shards.h), in draw order. kInvalidArgument for bad
+/// fit or Monte Carlo options; a campaign that cannot be fitted is a result (fit_status),
+/// not an error.
 Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
                                             const Calibration& calibration,
                                             const std::vector<stats::TrialValue>& values,
                                             const stats::SimResults& sim,
                                             const std::filesystem::path& cache_path,
+                                            const std::vector<fit::TensionSample>* monte_carlo,
                                             std::ostream& err);
 
 /// "fit" (liftoff rotation against the tension scale, hardware means, the fit) and

@@ -25,6 +25,7 @@
 #include "liftoff/stats/sim_results.h"
 #include "liftoff/stats/table.h"
 #include "report_calibration.h"
+#include "report_shards.h"
 #include "report_trials.h"
 
 namespace liftoff::cli {
@@ -85,18 +86,6 @@ struct SimColumn {
   fs::path cache_path;
   bool from_cache = false;
 };
-
-// 64-bit FNV-1a: a stable key across machines and runs (not a security hash)
-std::string HashHex(std::string_view bytes) {
-  uint64_t hash = 14695981039346656037ULL;
-  for (const char byte : bytes) {
-    hash ^= static_cast<unsigned char>(byte);
-    hash *= 1099511628211ULL;
-  }
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-  return text;
-}
 
 // what the sweep's values depend on: model bytes, calibration, every experiment option,
 // the feet and tension points, the ramp mode and the software version
@@ -448,12 +437,18 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
     }
   }
 
-  // the trials, as the table command analyses them
-  auto campaign = AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup,
-                                  command.sweep.experiment.progress, err);
+  // the trials, as the table command analyses them: all, a shard's, or merged from shards
+  auto shard = ReportShardFlags(command);
+  if (!shard.ok()) return ReportError(shard.status(), err);
+  std::vector<fit::TensionSample> merged_draws;
+  auto campaign = CampaignForReport(command, *shard, merged_draws, err);
   if (!campaign.ok()) return ReportError(campaign.status(), err);
   const Status outside = CheckInputsOutsideOutput(command, *campaign);
   if (!outside.ok()) return ReportError(outside, err);
+  if (!command.shard.empty()) {
+    const Status written = RunReportShard(command, *shard, *campaign, out, err);
+    return written.ok() ? kExitOk : ReportError(written, err);
+  }
 
   // the simulated column
   std::optional<SimColumn> sim;
@@ -469,7 +464,8 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
   if (sim) {
     auto calibrated =
         CalibrateCampaign(command, campaign->calibration, values, sim->results,
-                          fs::path(sim->cache_path).replace_extension(".calibration.json"), err);
+                          fs::path(sim->cache_path).replace_extension(".calibration.json"),
+                          command.merge.empty() ? nullptr : &merged_draws, err);
     if (!calibrated.ok()) return ReportError(calibrated.status(), err);
     calibration = std::move(calibrated).value();
   }
@@ -534,6 +530,15 @@ Subcommand AddReportCommand(CLI::App& parent) {
   app->add_option("--mc-sd-scale", command->monte_carlo.stddev_scale,
                   "Monte Carlo: Table I's standard deviations times this")
       ->capture_default_str();
+  app->add_option("--jobs,-j", command->jobs,
+                  "Trials analysed at once (0: the machine's cores; same results for any)")
+      ->capture_default_str();
+  app->add_option("--shard", command->shard,
+                  "i/n: analyse shard i of n (trials and Monte Carlo draws) and write "
+                  "DIR/shard-i-of-n.json instead of the report (docs/cluster.md)");
+  app->add_option("--merge", command->merge,
+                  "Shard files (every shard of one run) merged into the report")
+      ->expected(1, -1);
   return RunsWith(app, command, RunReport);
 }
 

@@ -100,39 +100,39 @@ std::vector<NamedPath> TableInputs(const TableCommand& command, const TrialManif
   return inputs;
 }
 
-// The lines about one trial a person should see: log warnings, the video's brief and
-// warnings, the failure, the lookup's notes.
-void PrintOutcomeNotes(const sync::TrialOutcome& outcome, std::ostream& err) {
-  PrintLogWarnings(outcome.log_report, err);
-  if (outcome.video) {
-    err << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
-    for (const std::string& warning : outcome.video->warnings) {
-      err << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
-    }
-  }
-  if (!outcome.status.ok()) {
-    err << "error: " << outcome.status.ToString() << '\n';
-    return;
-  }
-  for (const std::string& warning : outcome.measurement->lookup.warnings) {
-    err << "note: " << outcome.trial.id << ": " << warning << '\n';
-  }
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
 // liftoff table
 
-Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
-                                         const CalibrationChoice& calibration_choice,
-                                         const LookupChoice& lookup_choice,
-                                         std::string_view progress_mode, std::ostream& err) {
+std::vector<std::string> OutcomeNotes(const sync::TrialOutcome& outcome) {
+  std::ostringstream lines;
+  PrintLogWarnings(outcome.log_report, lines);
+  if (outcome.video) {
+    lines << "note: " << outcome.trial.id << ": video: " << outcome.video->Brief() << '\n';
+    for (const std::string& warning : outcome.video->warnings) {
+      lines << "warning: " << outcome.trial.id << ": video: " << warning << '\n';
+    }
+  }
+  if (!outcome.status.ok()) {
+    lines << "error: " << outcome.status.ToString() << '\n';
+  } else {
+    for (const std::string& warning : outcome.measurement->lookup.warnings) {
+      lines << "note: " << outcome.trial.id << ": " << warning << '\n';
+    }
+  }
+  std::vector<std::string> notes;
+  std::istringstream split(lines.str());
+  for (std::string line; std::getline(split, line);) notes.push_back(line);
+  return notes;
+}
+
+Result<CampaignAnalysis> LoadCampaign(const std::filesystem::path& manifest_path,
+                                      const CalibrationChoice& calibration_choice,
+                                      const LookupChoice& lookup_choice, std::ostream& err) {
   // options, then inputs: manifest (or a 2018 folder read as one) and calibration
   auto lookup = LookupOptionsFrom(lookup_choice);
   if (!lookup.ok()) return lookup.status();
-  auto progress = VideoProgress::Create(progress_mode, err);
-  if (!progress.ok()) return progress.status();
   CampaignAnalysis campaign;
   auto manifest = LoadTrials(manifest_path, err);
   if (!manifest.ok()) return manifest.status();
@@ -141,30 +141,41 @@ Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_p
       calibration_choice, campaign.manifest.calibration_path.value_or(std::filesystem::path()));
   if (!calibration.ok()) return calibration.status();
   campaign.calibration = std::move(calibration).value();
+  campaign.analysis.calibration = campaign.calibration.Brief();
+  campaign.analysis.rule = lookup->rule;
+  return campaign;
+}
+
+Result<CampaignAnalysis> AnalyzeCampaign(const std::filesystem::path& manifest_path,
+                                         const CalibrationChoice& calibration_choice,
+                                         const LookupChoice& lookup_choice, const CampaignRun& run,
+                                         std::ostream& err) {
+  if (auto progress = ProgressLine::Create(run.progress, "--progress", "video", err);
+      !progress.ok()) {
+    return progress.status();
+  }
+  auto loaded = LoadCampaign(manifest_path, calibration_choice, lookup_choice, err);
+  if (!loaded.ok()) return loaded.status();
+  CampaignAnalysis& campaign = *loaded;
 
   // every trial through sync (videos without times through video analysis)
   sync::AnalysisOptions options;
-  options.lookup = *lookup;
+  options.lookup = *LookupOptionsFrom(lookup_choice);
   options.log.max_bad_lines = lookup_choice.max_bad_lines;
-  options.video_progress = [&](const TrialRecord& trial, int64_t frames_done, int64_t t_ns) {
-    progress->Show(trial.id, frames_done, t_ns);
-  };
-  campaign.analysis = sync::AnalyzeManifest(campaign.manifest, campaign.calibration, options);
-  progress->Done();
+  auto outcomes = AnalyzeTrials(campaign.manifest, campaign.calibration, options, run,
+                                campaign.trial_indices, err);
+  if (!outcomes.ok()) return outcomes.status();
+  campaign.analysis.outcomes = std::move(outcomes).value();
 
   // what a person should know about each trial, on `err` and kept per trial
   for (const sync::TrialOutcome& outcome : campaign.analysis.outcomes) {
-    std::ostringstream lines;
-    PrintOutcomeNotes(outcome, lines);
-    err << lines.str();
-    std::vector<std::string>& notes = campaign.notes.emplace_back();
-    std::istringstream split(lines.str());
-    for (std::string line; std::getline(split, line);) notes.push_back(line);
+    std::vector<std::string>& notes = campaign.notes.emplace_back(OutcomeNotes(outcome));
+    for (const std::string& line : notes) err << line << '\n';
     if (!outcome.status.ok() && campaign.first_failure.ok()) {
       campaign.first_failure = outcome.status;
     }
   }
-  return campaign;
+  return loaded;
 }
 
 int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) {
@@ -193,8 +204,10 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   }
 
   // every trial; failures are reported and the rest still tabulated
-  auto campaign = AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup,
-                                  command.progress, err);
+  CampaignRun run;
+  run.progress = command.progress;
+  auto campaign =
+      AnalyzeCampaign(command.manifest_path, command.calibration, command.lookup, run, err);
   if (!campaign.ok()) return ReportError(campaign.status(), err);
   // nothing is written before this: no output may be one of the inputs
   if (const int refused = RefuseToOverwriteInputs(

@@ -529,7 +529,9 @@ Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration
     return InvalidArgumentError(calibration.Brief() +
                                 ": /materials: the Monte Carlo needs silicone, buna_n and spring");
   }
-  SplitMix64 random(options.seed);
+  // each draw its own stream, seeded by the seed and its index: draw k is the same
+  // whichever draws are made with it (a shard of the Monte Carlo draws only its own)
+  SplitMix64 random(0);
   auto draw = [&](const MaterialConstant& material) {
     for (;;) {
       const double value = material.stiffness_n_per_m + options.stddev_scale *
@@ -540,6 +542,9 @@ Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration
   };
   std::vector<TensionPoint> draws;
   for (int i = 1; i <= options.samples; ++i) {
+    constexpr uint64_t kIndexMix = 0xD1B54A32D192ED03;  // odd: index -> seed is one to one
+    SplitMix64 seeder(options.seed ^ (kIndexMix * static_cast<uint64_t>(i)));
+    random = SplitMix64(seeder.Next());
     TensionPoint& point = draws.emplace_back();
     char name[16];
     std::snprintf(name, sizeof name, "mc-%04d", i);

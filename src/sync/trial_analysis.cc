@@ -124,16 +124,21 @@ ManifestAnalysis AnalyzeManifest(const TrialManifest& manifest, const Calibratio
   ManifestAnalysis analysis;
   analysis.calibration = calibration.Brief();
   analysis.rule = options.lookup.rule;
-  const Status options_status = options.Validate();
-  for (const TrialRecord& trial : manifest.trials) {
-    TrialOutcome outcome;
-    outcome.trial = trial;
-    // bad options fail every trial alike; otherwise each trial stands alone
-    outcome.status = options_status.ok() ? AnalyzeTrial(manifest, calibration, options, outcome)
-                                         : options_status.WithContext(trial.id);
-    analysis.outcomes.push_back(std::move(outcome));
+  for (size_t i = 0; i < manifest.trials.size(); ++i) {
+    analysis.outcomes.push_back(AnalyzeManifestTrial(manifest, calibration, options, i));
   }
   return analysis;
+}
+
+TrialOutcome AnalyzeManifestTrial(const TrialManifest& manifest, const Calibration& calibration,
+                                  const AnalysisOptions& options, size_t index) {
+  TrialOutcome outcome;
+  outcome.trial = manifest.trials.at(index);
+  // bad options fail every trial alike; otherwise each trial stands alone
+  const Status options_status = options.Validate();
+  outcome.status = options_status.ok() ? AnalyzeTrial(manifest, calibration, options, outcome)
+                                       : options_status.WithContext(outcome.trial.id);
+  return outcome;
 }
 
 }  // namespace liftoff::sync

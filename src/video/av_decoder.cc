@@ -118,7 +118,7 @@ struct AvDecoder::Impl {
     if (format != nullptr) avformat_close_input(&format);
   }
 
-  Status OpenStream(const std::string& path);
+  Status OpenStream(const std::string& path, int threads);
   void ReadFacts();
   cv::Size Extent() const;
   void ConvertWhole(cv::Mat& bgr);
@@ -127,7 +127,7 @@ struct AvDecoder::Impl {
   bool RegionsMatchWhole(const std::vector<cv::Rect>& regions, const cv::Mat& bgr);
 };
 
-Status AvDecoder::Impl::OpenStream(const std::string& path) {
+Status AvDecoder::Impl::OpenStream(const std::string& path, int threads) {
   if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) {
     return ParseError("FFmpeg cannot open it");
   }
@@ -156,8 +156,9 @@ Status AvDecoder::Impl::OpenStream(const std::string& path) {
     return ParseError("the stream's parameters are unusable");
   }
   codec->pkt_timebase = stream->time_base;
-  codec->thread_count = static_cast<int>(
-      std::clamp(std::thread::hardware_concurrency(), 1u, kMaxThreads));
+  codec->thread_count = static_cast<int>(std::clamp(
+      threads > 0 ? static_cast<unsigned>(threads) : std::thread::hardware_concurrency(), 1u,
+      kMaxThreads));
   if (avcodec_open2(codec, decoder, nullptr) < 0) {
     return ParseError(std::string("the ") + decoder->name + " decoder refused the stream");
   }
@@ -192,9 +193,9 @@ void AvDecoder::Impl::ReadFacts() {
   facts.height_px = turned ? stream->codecpar->width : stream->codecpar->height;
 }
 
-Result<std::unique_ptr<AvDecoder>> AvDecoder::Open(const std::string& path) {
+Result<std::unique_ptr<AvDecoder>> AvDecoder::Open(const std::string& path, int threads) {
   auto impl = std::make_unique<Impl>();
-  LIFTOFF_RETURN_IF_ERROR(impl->OpenStream(path));
+  LIFTOFF_RETURN_IF_ERROR(impl->OpenStream(path, threads));
   return std::unique_ptr<AvDecoder>(new AvDecoder(std::move(impl)));
 }
 

@@ -41,7 +41,8 @@ class AvDecoder {
  public:
   /// Opens `path`'s first video stream. kParse with the reason ("FFmpeg cannot open it",
   /// "no video stream", "no decoder for hevc") when it cannot; the caller names the file.
-  static Result<std::unique_ptr<AvDecoder>> Open(const std::string& path);
+  /// `threads`: the decoder's frame and slice threads; 0: the machine's cores (at most 16).
+  static Result<std::unique_ptr<AvDecoder>> Open(const std::string& path, int threads = 0);
   ~AvDecoder();
   AvDecoder(const AvDecoder&) = delete;
   AvDecoder& operator=(const AvDecoder&) = delete;

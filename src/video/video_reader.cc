@@ -215,6 +215,10 @@ Status VideoReader::Options::Validate() const {
   if (max_listed < 0) {
     return InvalidArgumentError("max_listed: expected >= 0, got " + std::to_string(max_listed));
   }
+  if (decoder_threads < 0 || decoder_threads > 64) {
+    return InvalidArgumentError("decoder_threads: expected an integer in [0, 64], got " +
+                                std::to_string(decoder_threads));
+  }
   return Status::Ok();
 }
 
@@ -412,7 +416,7 @@ Result<VideoReader> VideoReader::Open(const fs::path& path, const Options& optio
   {
     CatchDecoderLog catching(impl->decoder_log);
     Result<std::unique_ptr<internal::AvDecoder>> decoder =
-        internal::AvDecoder::Open(path.string());
+        internal::AvDecoder::Open(path.string(), options.decoder_threads);
     if (!decoder.ok()) {
       return damaged("no decoder could open it (" + decoder.status().message() + ")" +
                      impl->FfmpegSays());

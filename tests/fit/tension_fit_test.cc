@@ -276,6 +276,27 @@ TEST(MonteCarloDraws, AreReproducibleAndSpreadAsTableOneSays) {
   EXPECT_NE((*other)[0].silicone_n_per_m, (*first)[0].silicone_n_per_m);
 }
 
+// Each draw has its own stream seeded by its index: the draws of a short run are the first
+// of a long one, and no two draws repeat (the report's shards rely on it).
+TEST(MonteCarloDraws, EachDrawIsSeededByItsIndex) {
+  const Calibration calibration = Laika2018();
+  MonteCarloOptions options;
+  options.samples = 3;
+  auto few = MonteCarloDraws(calibration, options);
+  options.samples = 50;
+  auto many = MonteCarloDraws(calibration, options);
+  ASSERT_TRUE(few.ok() && many.ok());
+  for (size_t i = 0; i < few->size(); ++i) {
+    EXPECT_EQ((*few)[i].name, (*many)[i].name);
+    EXPECT_EQ((*few)[i].silicone_n_per_m, (*many)[i].silicone_n_per_m) << i;
+    EXPECT_EQ((*few)[i].buna_n_n_per_m, (*many)[i].buna_n_n_per_m) << i;
+  }
+  for (size_t i = 1; i < many->size(); ++i) {
+    EXPECT_NE((*many)[i].silicone_n_per_m, (*many)[i - 1].silicone_n_per_m) << i;
+    EXPECT_NE((*many)[i].buna_n_n_per_m, (*many)[i - 1].buna_n_n_per_m) << i;
+  }
+}
+
 TEST(MonteCarlo, SimulatedSpreadGrowsWithTheStandardDeviations) {
   const Calibration calibration = Laika2018();
   const sim::ModelDescription model = Laika();

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "liftoff/cli/commands.h"
 #include "liftoff/cli/sim_commands.h"
@@ -40,12 +41,21 @@ struct ReportCommand {
   fit::MonteCarloOptions monte_carlo;
   /// The gnuplot program (found on the PATH unless a path is given).
   std::string gnuplot = "gnuplot";
+  /// Trials analysed at once (0: the machine's cores); the results are the same for any.
+  int jobs = 0;
+  /// "i/n": analyse only shard i of n (the trials and Monte Carlo draws k with
+  /// k % n == i - 1) and write DIR/shard-i-of-n.json instead of the report. Empty: all.
+  std::string shard;
+  /// Shard files to merge into the report instead of analysing the trials and running the
+  /// Monte Carlo (docs/cluster.md); every shard of one run, made with the same flags.
+  std::vector<std::filesystem::path> merge;
 };
 
 /// Writes the report. Exit code: 0 when every trial was analysed and every file written;
 /// a failing trial's class (ExitCodeFor) after the report of the others is written, as
 /// `liftoff table` does; gnuplot missing or failing is a warning (data and scripts are
-/// still written).
+/// still written). With `shard`: 0 once the shard file is written (its failed trials are
+/// in it; the merge exits as one run would).
 int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err);
 
 /// The command added to the command line `parent` (flags bound to its struct).

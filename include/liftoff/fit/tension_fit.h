@@ -228,6 +228,8 @@ struct MonteCarloOptions {
 /// and standard deviation (times stddev_scale), drawn independently per draw and material
 /// and applied to every cable of that material (lattice-wide, not per cable); values
 /// below 1 % of the mean are drawn again. Named "mc-0001" ..; sigma is the draw's index.
+/// Draw i has its own random stream seeded by (seed, i): the first k draws of n are the
+/// draws of k, and any subset can be drawn alone (the report's shards).
 /// kInvalidArgument when the calibration lacks silicone, buna_n or spring.
 Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration,
                                                   const MonteCarloOptions& options);

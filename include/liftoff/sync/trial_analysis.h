@@ -87,4 +87,10 @@ struct ManifestAnalysis {
 ManifestAnalysis AnalyzeManifest(const TrialManifest& manifest, const Calibration& calibration,
                                  const AnalysisOptions& options);
 
+/// The manifest's trial `index` (< manifest.trials.size()) alone, as AnalyzeManifest
+/// analyses it: trials share nothing, so callers may analyse several at once on their own
+/// threads (options.video_progress is then called from those threads).
+TrialOutcome AnalyzeManifestTrial(const TrialManifest& manifest, const Calibration& calibration,
+                                  const AnalysisOptions& options, size_t index);
+
 }  // namespace liftoff::sync

@@ -89,6 +89,9 @@ class VideoReader {
     int median_window_frames = 31;
     /// Most irregularities listed in the report (counts stay complete); >= 0.
     int max_listed = 1000;
+    /// The decoder's threads (0 .. 64; 0: the machine's cores, at most 16). Decoded frames
+    /// are the same whatever the count; lower it when several clips decode at once.
+    int decoder_threads = 0;
 
     Status Validate() const;
   };
