@@ -335,7 +335,8 @@ Status DrawFigure(const std::string& program, const fs::path& dir, const std::st
   const std::string cd = "cd '" + dir.string() + "'";
   const std::string script = (dir / (name + ".gp")).string();
   const std::string log = (dir / (name + ".log")).string();
-  std::vector<std::string> arguments = {program, "-e", cd, script};
+  // the script by its name: gnuplot has changed to `dir` when it reads it
+  std::vector<std::string> arguments = {program, "-e", cd, name + ".gp"};
   std::vector<char*> argv;
   for (std::string& argument : arguments) argv.push_back(argument.data());
   argv.push_back(nullptr);

@@ -839,10 +839,12 @@ std::string Set3dSummary::Brief() const {
 }
 
 Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Trial3dSpec>& set,
-                                  const std::filesystem::path& output_dir,
+                                  const std::filesystem::path& output_folder,
                                   const Calibration& calibration, const std::string& description,
                                   const Set3dProgress& progress) {
   const int64_t started_ns = MonotonicNowNs();
+  // absolute, so that the manifest's paths come out relative to its own folder
+  const std::filesystem::path output_dir = std::filesystem::absolute(output_folder);
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<EglContext> context, EglContext::Create());
   Set3dSummary summary;
   summary.name = name;

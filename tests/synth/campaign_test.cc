@@ -44,6 +44,17 @@ TEST(Campaign, TwentyTrialsFivePerFootOnTheFastRampAsDocumented) {
     EXPECT_DOUBLE_EQ(spec.theta_rate_rad_s, (std::numbers::pi / 3) / 7);
     EXPECT_GE(spec.led_on_s, 0.8);
     EXPECT_LE(spec.led_on_s, 1.2);
+    EXPECT_GE(spec.scene.camera_distance_m, 0.66);
+    EXPECT_LE(spec.scene.camera_distance_m, 0.76);
+    EXPECT_GE(spec.scene.camera_height_m, 0.32);
+    EXPECT_LE(spec.scene.camera_height_m, 0.40);
+    EXPECT_GE(spec.noise_sigma, 0.0);
+    EXPECT_LE(spec.noise_sigma, 2.0);
+    EXPECT_DOUBLE_EQ(spec.after_lift_s, 0.25);
+    const bool alternate = spec.foot == Foot::kA || spec.foot == Foot::kC;
+    EXPECT_EQ(spec.scene.view, spec.foot == Foot::kB || (alternate && i % 2 == 1)
+                                   ? CameraView::kOblique
+                                   : CameraView::kSide);
     ASSERT_TRUE(spec.tension.has_value());
     EXPECT_EQ(spec.tension->name, "campaign-" + spec.id);
   }

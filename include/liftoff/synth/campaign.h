@@ -20,9 +20,12 @@
 // rotation depends a little on the rate, so the report must simulate the same ramp:
 // `liftoff report MANIFEST --ramp-s <ramp_s>` (ReportFlags, also in the truth file).
 //
-// The cameras. Side and oblique views alternate; camera distance and height, light, foot
-// shape, LED switch-on time (about 1 s in), sensor noise and every seed vary per trial.
-// Each clip ends 0.25 s after the 1 mm instant.
+// The cameras. Each foot in a view that shows it clearly (A and C: side and oblique in
+// turn; B: oblique; D: side, aimed left of the robot); camera distance and height, light,
+// clutter, the LED switch-on (0.8 .. 1.2 s in), sensor noise and every seed vary per trial.
+// Spherical feet (the block and the rubber tip failed more often at this scale). Lossless
+// FFV1 video, 480x360, 30 fps: H.264's lag costs frames on this fast ramp. Each clip ends
+// 0.25 s after the 1 mm instant.
 #pragma once
 
 #include <cstdint>
