@@ -47,8 +47,6 @@ void VaryCamera(Trial3dSpec& spec, int k, SplitMix64& random) {
   const bool alternate = spec.foot == Foot::kA || spec.foot == Foot::kC;
   scene.view = spec.foot == Foot::kB || (alternate && k % 2 == 1) ? CameraView::kOblique
                                                                   : CameraView::kSide;
-  // foot D sits at the side view's left edge: aim left of the robot's centre
-  if (spec.foot == Foot::kD) scene.aim_offset_m = -0.12;
   scene.camera_distance_m = 0.66 + 0.10 * random.Uniform();
   scene.camera_height_m = 0.32 + 0.08 * random.Uniform();
   scene.light_elevation_deg = 35 + 40 * random.Uniform();

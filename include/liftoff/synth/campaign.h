@@ -21,7 +21,7 @@
 // `liftoff report MANIFEST --ramp-s <ramp_s>` (ReportFlags, also in the truth file).
 //
 // The cameras. Each foot in a view that shows it clearly (A and C: side and oblique in
-// turn; B: oblique; D: side, aimed left of the robot); camera distance and height, light,
+// turn; B: oblique; D: side); camera distance and height, light,
 // clutter, the LED switch-on (0.8 .. 1.2 s in), sensor noise and every seed vary per trial.
 // Spherical feet (the block and the rubber tip failed more often at this scale). Lossless
 // FFV1 video, 480x360, 30 fps: H.264's lag costs frames on this fast ramp. Each clip ends
