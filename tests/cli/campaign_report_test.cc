@@ -218,7 +218,7 @@ TEST(CampaignReport, VideosToTableFiguresPagesAndTheHiddenTension) {
 
   // the pages' links resolve
   // (the Markdown links its figures, their scripts and data; the page inlines its figures)
-  ExpectLinksResolve(dir / "report.md", "](", ')', 12);
+  ExpectLinksResolve(dir / "report.md", "](", ')', 8);
   ExpectLinksResolve(dir / "report.html", "src=\"", '"', 4);
   ExpectLinksResolve(dir / "report.html", "href=\"", '"', 0);
 
