@@ -14,6 +14,7 @@
 #include "liftoff/synth/spec.h"
 #include "liftoff/synth/trial_writer.h"
 #if LIFTOFF_HAVE_SYNTH3D
+#include "liftoff/synth/campaign.h"
 #include "liftoff/synth/trial3d.h"
 #endif
 
@@ -84,14 +85,32 @@ int RunSet(const SynthCommand& command, const Calibration& calibration, std::ost
   return kExitOk;
 }
 
-// The 3D camera's set (trial3d.h): its own folder format, no calibration needed.
-int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
-             std::ostream& err) {
 #if LIFTOFF_HAVE_SYNTH3D
+synth::CampaignOptions CampaignOptionsFrom(const SynthCommand& command) {
+  synth::CampaignOptions options;
+  options.trials_per_foot = command.campaign_trials_per_foot;
+  return options;
+}
+
+// The 3D set or campaign of the command, written.
+Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
+                                            const Calibration& calibration, std::ostream& err) {
   const auto progress = [&](int index, int count, const std::string& id) {
     if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
   };
-  auto summary = synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress);
+  if (command.set_name != "campaign") {
+    return synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress);
+  }
+  return synth::WriteCampaign(CampaignOptionsFrom(command), calibration, command.output_dir,
+                             progress);
+}
+#endif
+
+// The 3D camera's sets (trial3d.h, campaign.h): their own folder format.
+int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::ostream& out,
+             std::ostream& err) {
+#if LIFTOFF_HAVE_SYNTH3D
+  auto summary = WriteNamedSet3d(command, calibration, err);
   if (!summary.ok()) return ReportError(summary.status(), err);
   for (const synth::WrittenTrial3d& written : summary->trials) {
     const auto seconds = [](const std::optional<double>& value, int places) {
@@ -106,8 +125,14 @@ int RunSet3d(const SynthCommand& command, const Calibration& calibration, std::o
   }
   out << summary->Brief() << '\n' << "renderer: " << summary->renderer << '\n'
       << "manifest: " << (command.output_dir / "manifest.json").string() << '\n'
-      << "index: " << (command.output_dir / "set.json").string() << '\n'
-      << "calibration: " << calibration.Brief() << '\n';
+      << "index: " << (command.output_dir / "set.json").string() << '\n';
+  if (command.set_name == "campaign") {
+    out << "truth: " << (command.output_dir / "campaign-truth.json").string()
+        << " (the hidden tension; liftoff report never reads it)\n"
+        << "report: liftoff report " << (command.output_dir / "manifest.json").string() << ' '
+        << synth::CampaignReportFlags(CampaignOptionsFrom(command)) << " -o DIR\n";
+  }
+  out << "calibration: " << calibration.Brief() << '\n';
   return kExitOk;
 #else
   (void)out;
@@ -139,7 +164,8 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
-  if (command.set_name == "ci3d" || command.set_name == "hard3d") {
+  if (command.set_name == "ci3d" || command.set_name == "hard3d" ||
+      command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);
   }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
@@ -153,7 +179,10 @@ Subcommand AddSynthCommand(CLI::App& parent) {
       "Render synthetic trials (video, controller log, ground truth) from a spec or a set");
   app->add_option("spec", command->spec_path, "Trial spec JSON (see --print-spec)");
   app->add_option("--set", command->set_name,
-                  "Write a whole named set: ci, paper, ci3d or hard3d (the 3D camera)");
+                  "Write a whole named set: ci, paper, ci3d, hard3d or campaign (the 3D camera)");
+  app->add_option("--per-foot", command->campaign_trials_per_foot,
+                  "--set campaign: trials per foot (1 .. 20)")
+      ->capture_default_str();
   app->add_option("--output,-o", command->output_dir, "Folder for the files");
   app->add_flag("--print-spec", command->print_spec, "Print the default spec as JSON");
   app->add_flag("--quiet,-q", command->quiet, "No progress lines on stderr");

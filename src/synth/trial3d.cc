@@ -205,6 +205,14 @@ Status Trial3dSpec::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(scene.Validate().WithContext("trial3d " + id));
   if (tension_point_index < 0 || tension_point_index > 4)
     return OutOfRange(id, "tension_point_index", tension_point_index, 0, 4);
+  if (tension) {
+    for (const auto& [field, value] :
+         {std::pair{"tension.silicone_n_per_m", tension->silicone_n_per_m},
+          std::pair{"tension.buna_n_n_per_m", tension->buna_n_n_per_m},
+          std::pair{"tension.spring_n_per_m", tension->spring_n_per_m}}) {
+      if (!(value >= 1 && value <= 1e5)) return OutOfRange(id, field, value, 1, 1e5);
+    }
+  }
   if (!(theta_rate_rad_s >= 0.005 && theta_rate_rad_s <= 1))
     return OutOfRange(id, "theta_rate_rad_s", theta_rate_rad_s, 0.005, 1);
   if (!(max_rotation_rad >= 0.05 && max_rotation_rad <= kPi / 3 + 1e-12))
@@ -253,6 +261,7 @@ Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec) {
   sim::ExperimentOptions options;
   options.foot = spec.foot;
   options.tension_point_index = spec.tension_point_index;
+  options.tension_point = spec.tension;
   options.ramp_angle_rad = spec.max_rotation_rad;
   options.ramp_duration_s = spec.max_rotation_rad / spec.theta_rate_rad_s;
   LIFTOFF_ASSIGN_OR_RETURN(sim::ExperimentResult run, sim::RunExperiment(description, options));
@@ -491,6 +500,9 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
       {"clutter_count", scene.clutter_count}, {"light_elevation_deg", scene.light_elevation_deg},
       {"light_azimuth_deg", scene.light_azimuth_deg}, {"light_level", scene.light_level},
       {"led_radius_m", scene.led_radius_m}, {"tension_point_index", spec.tension_point_index},
+      {"tension_point", spec.tension ? spec.tension->name
+                                     : sim::PaperTensionPoints()[static_cast<size_t>(
+                                           spec.tension_point_index)].name},
       {"max_rotation_rad", spec.max_rotation_rad}, {"drop_probability", spec.drop_probability},
       {"timestamp_jitter_s", spec.timestamp_jitter_s},
       {"drop_frames_at_led", spec.drop_frames_at_led}, {"quality", spec.quality},
@@ -595,8 +607,8 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
     entry.led_roi_px = region(truth["led_roi"]);
     entry.foot_roi_px = region(truth["foot_roi"]);
     entry.px_per_mm = truth["pixels_per_mm"].get<double>();
-    entry.notes = "synthetic 3D (liftoff synth --set ci3d, seed " + std::to_string(spec.seed) +
-                  "); truth in " + spec.id + "/truth.json";
+    entry.notes = "synthetic 3D (liftoff synth, seed " + std::to_string(spec.seed) + "); truth in " +
+                  spec.id + "/truth.json";
     written.manifest_entry = std::move(entry);
   }
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.truth_path, written.truth_json));
@@ -826,12 +838,13 @@ std::string Set3dSummary::Brief() const {
   return out.str();
 }
 
-Result<Set3dSummary> WriteSet3d(
-    const std::string& name, const std::filesystem::path& output_dir,
-    const Calibration& calibration,
-    const std::function<void(int index, int count, const std::string& id)>& progress) {
+Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Trial3dSpec>& set,
+                                  const std::filesystem::path& output_folder,
+                                  const Calibration& calibration, const std::string& description,
+                                  const Set3dProgress& progress) {
   const int64_t started_ns = MonotonicNowNs();
-  LIFTOFF_ASSIGN_OR_RETURN(const std::vector<Trial3dSpec> set, Set3dNamed(name));
+  // absolute, so that the manifest's paths come out relative to its own folder
+  const std::filesystem::path output_dir = std::filesystem::absolute(output_folder);
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<EglContext> context, EglContext::Create());
   Set3dSummary summary;
   summary.name = name;
@@ -856,7 +869,8 @@ Result<Set3dSummary> WriteSet3d(
     summary.trials.push_back(std::move(*written));
   }
   TrialManifest manifest;
-  manifest.description = "liftoff synth set " + name + " (" + calibration.name + ")";
+  manifest.description =
+      description.empty() ? "liftoff synth set " + name + " (" + calibration.name + ")" : description;
   if (!calibration.source_path.empty()) manifest.calibration_path = calibration.source_path;
   for (const WrittenTrial3d& trial : summary.trials) {
     if (trial.manifest_entry) manifest.trials.push_back(*trial.manifest_entry);
@@ -867,6 +881,12 @@ Result<Set3dSummary> WriteSet3d(
   index["manifest"] = "manifest.json";
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(output_dir / "set.json", index.dump(1) + "\n"));
   return summary;
+}
+
+Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
+                                const Calibration& calibration, const Set3dProgress& progress) {
+  LIFTOFF_ASSIGN_OR_RETURN(const std::vector<Trial3dSpec> set, Set3dNamed(name));
+  return WriteSpecs3d(name, set, output_dir, calibration, "", progress);
 }
 
 }  // namespace liftoff::synth

@@ -19,8 +19,11 @@ namespace liftoff::cli {
 struct SynthCommand {
   /// Trial spec (JSON, docs/synth.md); relative CSV paths inside resolve against its folder.
   std::filesystem::path spec_path;
-  /// Named set: "ci", "paper" or "ci3d" (the 3D camera, trial3d.h).
+  /// Named set: "ci", "paper", "ci3d", "hard3d" or "campaign" (the 3D camera, trial3d.h,
+  /// campaign.h).
   std::string set_name;
+  /// --set campaign: trials per foot (CampaignOptions::trials_per_foot).
+  int campaign_trials_per_foot = 5;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.

@@ -60,8 +60,12 @@ struct Trial3dSpec {
   Scene3dOptions scene;
   /// The foot that lifts; the simulation pulls and turns as sim::MotionFor(foot).
   Foot foot = Foot::kA;
-  /// The simulation's tension point, 0 (low) .. 4 (high): see sim::PaperTensionPoints.
+  /// The simulation's tension point, 0 (low) .. 4 (high): see sim::PaperTensionPoints ...
   int tension_point_index = 4;
+  /// ... or explicit stiffnesses (win when set; each 1 .. 100000 N/m), e.g. a point on the
+  /// calibration's tension line (fit::TensionAtSigma) or a draw around one (campaign.h).
+  /// The truth names the point ("tension_point") but not its stiffnesses.
+  std::optional<TensionPoint> tension;
   /// The vertebra's ramp rate, rad/s (0.005 .. 1; the paper's is 0.02618), and where the
   /// ramp stops (held there), rad (0.05 .. pi/3; below the liftoff rotation: the foot
   /// never lifts).
@@ -189,9 +193,10 @@ std::vector<Trial3dSpec> Hard3dSet();
 /// The 3D set of that name ("ci3d" or "hard3d"); kInvalidArgument for another.
 Result<std::vector<Trial3dSpec>> Set3dNamed(const std::string& name);
 
-/// Writes every trial of the named 3D set into `output_dir` on this thread (one EGL context; Mesa
-/// renders on all cores), then `manifest.json` (the ok clips) and `set.json` (the index:
-/// id, folder, expect, frames, render time).
+/// Writes every trial of `specs` (the set `name`) into `output_dir` on this thread (one EGL
+/// context; Mesa renders on all cores), then `manifest.json` (the ok clips; `description`
+/// as its description, empty: "liftoff synth set NAME (CALIBRATION)") and `set.json` (the
+/// index: id, folder, expect, frames, render time).
 /// `progress` (may be empty) is called before each trial with (index, count, id).
 struct Set3dSummary {
   std::string name;  ///< the set's: "ci3d", "hard3d"
@@ -202,8 +207,13 @@ struct Set3dSummary {
   /// "ci3d: 10 clips, 1234 frames in 61.2 s (render 35.1 ms/frame, encode 4.2 ms/frame)".
   std::string Brief() const;
 };
-Result<Set3dSummary> WriteSet3d(
-    const std::string& name, const std::filesystem::path& output_dir, const Calibration& calibration,
-    const std::function<void(int index, int count, const std::string& id)>& progress = {});
+using Set3dProgress = std::function<void(int index, int count, const std::string& id)>;
+Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Trial3dSpec>& specs,
+                                  const std::filesystem::path& output_dir,
+                                  const Calibration& calibration, const std::string& description,
+                                  const Set3dProgress& progress = {});
+/// The named set (Set3dNamed) through WriteSpecs3d.
+Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
+                                const Calibration& calibration, const Set3dProgress& progress = {});
 
 }  // namespace liftoff::synth
