@@ -1,5 +1,6 @@
 #include "liftoff/synth/campaign.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -26,17 +27,48 @@ Status OutOfRange(const char* field, double value, double low, double high) {
   return InvalidArgumentError(message);
 }
 
-// the hidden point plus one Monte Carlo draw's offset from the materials' means
-TensionPoint TrialTension(const TensionPoint& hidden, const TensionPoint& draw,
-                          const Calibration& calibration, const std::string& name) {
+// Each trial's offset from the hidden point: its Monte Carlo draw's offset from the
+// materials' means, less the mean offset of its foot's trials, so that every foot's trials
+// average to the hidden point exactly (a few random draws would otherwise move the
+// campaign's own tension away from the one it is said to hide). Draws come per foot in
+// runs of `per_foot`.
+std::vector<TensionPoint> CentredOffsets(const std::vector<TensionPoint>& draws,
+                                         const Calibration& calibration, int per_foot) {
   const auto mean = [&](const char* material) {
     return calibration.FindMaterial(material)->stiffness_n_per_m;
   };
+  std::vector<TensionPoint> offsets;
+  for (const TensionPoint& draw : draws) {
+    TensionPoint& offset = offsets.emplace_back();
+    offset.silicone_n_per_m = draw.silicone_n_per_m - mean("silicone");
+    offset.buna_n_n_per_m = draw.buna_n_n_per_m - mean("buna_n");
+    offset.spring_n_per_m = draw.spring_n_per_m - mean("spring");
+  }
+  for (size_t first = 0; first < offsets.size(); first += static_cast<size_t>(per_foot)) {
+    const size_t last = std::min(offsets.size(), first + static_cast<size_t>(per_foot));
+    TensionPoint centre;
+    for (size_t i = first; i < last; ++i) {
+      centre.silicone_n_per_m += offsets[i].silicone_n_per_m / static_cast<double>(last - first);
+      centre.buna_n_n_per_m += offsets[i].buna_n_n_per_m / static_cast<double>(last - first);
+      centre.spring_n_per_m += offsets[i].spring_n_per_m / static_cast<double>(last - first);
+    }
+    for (size_t i = first; i < last; ++i) {
+      offsets[i].silicone_n_per_m -= centre.silicone_n_per_m;
+      offsets[i].buna_n_n_per_m -= centre.buna_n_n_per_m;
+      offsets[i].spring_n_per_m -= centre.spring_n_per_m;
+    }
+  }
+  return offsets;
+}
+
+// the hidden point plus the trial's offset
+TensionPoint TrialTension(const TensionPoint& hidden, const TensionPoint& offset,
+                          const std::string& name) {
   TensionPoint point = hidden;
   point.name = name;
-  point.silicone_n_per_m += draw.silicone_n_per_m - mean("silicone");
-  point.buna_n_n_per_m += draw.buna_n_n_per_m - mean("buna_n");
-  point.spring_n_per_m += draw.spring_n_per_m - mean("spring");
+  point.silicone_n_per_m += offset.silicone_n_per_m;
+  point.buna_n_n_per_m += offset.buna_n_n_per_m;
+  point.spring_n_per_m += offset.spring_n_per_m;
   return point;
 }
 
@@ -130,6 +162,8 @@ Result<std::vector<Trial3dSpec>> CampaignSpecs(const Calibration& calibration,
   spread.stddev_scale = options.stiffness_sd_scale;
   LIFTOFF_ASSIGN_OR_RETURN(const std::vector<TensionPoint> draws,
                            fit::MonteCarloDraws(calibration, spread));
+  const std::vector<TensionPoint> offsets =
+      CentredOffsets(draws, calibration, options.trials_per_foot);
   const TensionPoint hidden =
       fit::TensionAtSigma(calibration.tension_points, options.tension_sigma, "hidden");
   SplitMix64 random(options.seed ^ kCameraStream);
@@ -144,8 +178,7 @@ Result<std::vector<Trial3dSpec>> CampaignSpecs(const Calibration& calibration,
     spec.scene.width_px = options.width_px;
     spec.scene.height_px = options.height_px;
     spec.foot = foot;
-    spec.tension = TrialTension(hidden, draws[static_cast<size_t>(i)], calibration,
-                                "campaign-" + spec.id);
+    spec.tension = TrialTension(hidden, offsets[static_cast<size_t>(i)], "campaign-" + spec.id);
     spec.theta_rate_rad_s = kRampAngleRad / options.ramp_s;
     spec.max_rotation_rad = kRampAngleRad;
     spec.after_lift_s = 0.25;
