@@ -26,6 +26,8 @@ namespace {
 namespace fs = std::filesystem;
 using liftoff::testing::CommandRun;
 using liftoff::testing::Quoted;
+using liftoff::testing::ExpectValidPng;
+using liftoff::testing::ExpectValidSvg;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using ::testing::HasSubstr;
@@ -58,23 +60,6 @@ std::vector<std::map<std::string, std::string>> CsvRecords(const std::string& te
   return records;
 }
 
-void ExpectValidPng(const fs::path& path) {
-  const std::string bytes = ReadFile(path);
-  ASSERT_GT(bytes.size(), 1000u) << path;
-  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << path;
-  EXPECT_EQ(bytes.substr(12, 4), "IHDR") << path;
-  EXPECT_EQ(bytes.substr(bytes.size() - 8, 4), "IEND") << path;
-}
-
-// gnuplot's SVG: an XML declaration, one <svg> element closed at the end
-void ExpectValidSvg(const fs::path& path) {
-  const std::string text = ReadFile(path);
-  EXPECT_THAT(text, HasSubstr("<svg")) << path;
-  const size_t close = text.rfind("</svg>");
-  ASSERT_NE(close, std::string::npos) << path;
-  EXPECT_EQ(text.find_first_not_of(" \r\n", close + 6), std::string::npos) << path;
-  EXPECT_THAT(text, HasSubstr("gnuplot")) << path;
-}
 
 // the targets of every `opening`...`closing` in `text`
 std::vector<std::string> Targets(const std::string& text, std::string_view opening, char closing) {

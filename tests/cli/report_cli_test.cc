@@ -26,6 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using liftoff::testing::CommandRun;
+using liftoff::testing::ExpectValidPng;
+using liftoff::testing::ExpectValidSvg;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::SourceDir;
@@ -67,20 +69,6 @@ std::vector<std::vector<std::string>> CsvRows(const std::string& text) {
     rows.push_back(fields);
   }
   return rows;
-}
-
-void ExpectValidPng(const fs::path& path) {
-  const std::string bytes = ReadFile(path);
-  ASSERT_GT(bytes.size(), 1000u) << path;
-  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << path;
-  EXPECT_EQ(bytes.substr(12, 4), "IHDR") << path;
-  EXPECT_EQ(bytes.substr(bytes.size() - 8, 4), "IEND") << path;
-}
-
-void ExpectValidSvg(const fs::path& path) {
-  const std::string text = ReadFile(path);
-  EXPECT_THAT(text, HasSubstr("<svg")) << path;
-  EXPECT_THAT(text, HasSubstr("</svg>")) << path;
 }
 
 // the targets of `opening`...`closing` in `text` (std::regex recurses per character: the

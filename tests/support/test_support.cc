@@ -14,6 +14,22 @@ std::filesystem::path SourceDir() {
   return LIFTOFF_SOURCE_DIR;
 }
 
+void ExpectValidPng(const std::filesystem::path& path) {
+  const std::string bytes = ReadFile(path);
+  ASSERT_GT(bytes.size(), 1000u) << path;
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << path;
+  EXPECT_EQ(bytes.substr(12, 4), "IHDR") << path;
+  EXPECT_EQ(bytes.substr(bytes.size() - 8, 4), "IEND") << path;
+}
+
+void ExpectValidSvg(const std::filesystem::path& path) {
+  const std::string text = ReadFile(path);
+  EXPECT_NE(text.find("<svg"), std::string::npos) << path;
+  const size_t close = text.rfind("</svg>");
+  ASSERT_NE(close, std::string::npos) << path;
+  EXPECT_EQ(text.find_first_not_of(" \r\n", close + 6), std::string::npos) << path;
+}
+
 std::optional<std::filesystem::path> FindOnPath(const std::string& name) {
   std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
   for (std::string folder; std::getline(path, folder, ':');) {

@@ -19,6 +19,11 @@ std::filesystem::path SourceDir();
 /// ../shared/reference next to the source tree (or $LIFTOFF_REFERENCE_DIR), when present.
 std::optional<std::filesystem::path> ReferenceDir();
 
+/// Expects `path` to hold a whole PNG: its signature, an IHDR first and an IEND last.
+void ExpectValidPng(const std::filesystem::path& path);
+/// Expects `path` to hold an SVG document: an <svg> element closed at the end.
+void ExpectValidSvg(const std::filesystem::path& path);
+
 /// The program `name` in a folder of PATH, or nullopt.
 std::optional<std::filesystem::path> FindOnPath(const std::string& name);
 
