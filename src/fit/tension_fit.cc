@@ -44,13 +44,6 @@ double StandardDeviation(const std::vector<double>& values) {
   return std::sqrt(sum / static_cast<double>(values.size() - 1));
 }
 
-// a standard normal number (Box-Muller; deterministic given the generator)
-double Gaussian(SplitMix64& random) {
-  const double u1 = 1.0 - random.Uniform();  // (0, 1]
-  const double u2 = random.Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
-}
-
 // ---------------------------------------------------------------------------------------
 // the fit on the interpolated curves
 
@@ -536,7 +529,7 @@ Result<std::vector<TensionPoint>> MonteCarloDraws(const Calibration& calibration
     for (;;) {
       const double value = material.stiffness_n_per_m + options.stddev_scale *
                                                             material.stiffness_stddev_n_per_m *
-                                                            Gaussian(random);
+                                                            random.Gaussian();
       if (value >= 0.01 * material.stiffness_n_per_m) return value;
     }
   };

@@ -51,12 +51,6 @@ uint64_t SeedFor(uint64_t seed, uint64_t stream, uint64_t index = 0) {
   return second.Next();
 }
 
-double Gaussian(SplitMix64& rng) {
-  const double u1 = 1.0 - rng.Uniform();  // (0, 1]
-  const double u2 = rng.Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
-}
-
 // ---------------------------------------------------------------------------------------
 // procedural texture: hashed value noise
 
@@ -735,7 +729,7 @@ cv::Point2d SceneRenderer::ShakeOffsetPx(int64_t frame_index) {
   };
   while (static_cast<int64_t>(shake_px_.size()) <= frame_index) {
     const cv::Point2d last = shake_px_.back();
-    const double dx = step_px * Gaussian(shake_rng_), dy = step_px * Gaussian(shake_rng_);
+    const double dx = step_px * shake_rng_.Gaussian(), dy = step_px * shake_rng_.Gaussian();
     shake_px_.emplace_back(reflect(last.x + dx), reflect(last.y + dy));
   }
   return shake_px_[static_cast<size_t>(frame_index)];

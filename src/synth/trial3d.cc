@@ -90,11 +90,6 @@ struct Effects {
 
   explicit Effects(const Trial3dSpec& s) : spec(s), shake_rng(s.seed ^ kShakeStream) {}
 
-  static double Gaussian(SplitMix64& rng) {
-    const double u1 = std::max(rng.Uniform(), 1e-300), u2 = rng.Uniform();
-    return std::sqrt(-2 * std::log(u1)) * std::cos(2 * kPi * u2);
-  }
-
   // the walk's offset of frame k (a reflected random walk, as the 2D renderer's)
   cv::Point2d ShakeAt(size_t frame) {
     const auto reflect = [](double x) {
@@ -103,7 +98,7 @@ struct Effects {
     };
     while (shake.size() <= frame) {
       const cv::Point2d last = shake.back();
-      const double dx = spec.shake_px * Gaussian(shake_rng), dy = spec.shake_px * Gaussian(shake_rng);
+      const double dx = spec.shake_px * shake_rng.Gaussian(), dy = spec.shake_px * shake_rng.Gaussian();
       shake.emplace_back(reflect(last.x + dx), reflect(last.y + dy));
     }
     return spec.shake_px > 0 ? shake[frame] : cv::Point2d(0, 0);

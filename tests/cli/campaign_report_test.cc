@@ -26,6 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using liftoff::testing::CommandRun;
 using liftoff::testing::Quoted;
+using liftoff::testing::ExpectLinksResolve;
 using liftoff::testing::ExpectValidPng;
 using liftoff::testing::ExpectValidSvg;
 using liftoff::testing::ReadFile;
@@ -60,32 +61,8 @@ std::vector<std::map<std::string, std::string>> CsvRecords(const std::string& te
   return records;
 }
 
-
-// the targets of every `opening`...`closing` in `text`
-std::vector<std::string> Targets(const std::string& text, std::string_view opening, char closing) {
-  std::vector<std::string> targets;
-  for (size_t at = text.find(opening); at != std::string::npos; at = text.find(opening, at)) {
-    at += opening.size();
-    const size_t end = text.find(closing, at);
-    if (end == std::string::npos) break;
-    targets.push_back(text.substr(at, end - at));
-  }
-  return targets;
-}
-
-void ExpectLinksResolve(const fs::path& page, std::string_view opening, char closing,
-                        size_t at_least) {
-  const std::vector<std::string> targets = Targets(ReadFile(page), opening, closing);
-  EXPECT_GE(targets.size(), at_least) << page;
-  for (const std::string& target : targets) {
-    if (target.rfind("data:", 0) == 0 || target.rfind("#", 0) == 0) continue;
-    EXPECT_FALSE(target.rfind("http", 0) == 0) << page << " links outside: " << target;
-    EXPECT_TRUE(fs::exists(page.parent_path() / target)) << page << " links to " << target;
-  }
-}
-
-// "sigma +0.712 +- 0.081 (...; 95 % [0.550, 0.850])" in calibration.md
-// What calibration.md states: the fit, its bootstrap (standard deviation, 95 %), its
+// What calibration.md states ("- sigma +0.712 +- 0.081 (...; 95 % [0.550, 0.850])", then
+// "- systematic +- ..."): the fit, its bootstrap (standard deviation, 95 %), its
 // systematic term (a bias the trials share) and the two together.
 struct StatedFit {
   double sigma = NAN, stddev = NAN, low95 = NAN, high95 = NAN, systematic = NAN, total = NAN;

@@ -26,8 +26,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using liftoff::testing::CommandRun;
+using liftoff::testing::ExpectLinksResolve;
 using liftoff::testing::ExpectValidPng;
 using liftoff::testing::ExpectValidSvg;
+using liftoff::testing::LinkTargets;
 using liftoff::testing::ReadFile;
 using liftoff::testing::ScratchDir;
 using liftoff::testing::SourceDir;
@@ -69,31 +71,6 @@ std::vector<std::vector<std::string>> CsvRows(const std::string& text) {
     rows.push_back(fields);
   }
   return rows;
-}
-
-// the targets of `opening`...`closing` in `text` (std::regex recurses per character: the
-// inlined images would overflow its stack)
-std::vector<std::string> Targets(const std::string& text, std::string_view opening,
-                                 char closing) {
-  std::vector<std::string> targets;
-  for (size_t at = text.find(opening); at != std::string::npos; at = text.find(opening, at)) {
-    at += opening.size();
-    const size_t end = text.find(closing, at);
-    if (end == std::string::npos) break;
-    targets.push_back(text.substr(at, end - at));
-  }
-  return targets;
-}
-
-// every link of a page: inline data, or a file that exists beside the page
-void ExpectLinksResolve(const fs::path& page, std::string_view opening, char closing,
-                        size_t at_least) {
-  const std::vector<std::string> targets = Targets(ReadFile(page), opening, closing);
-  EXPECT_GE(targets.size(), at_least) << page;
-  for (const std::string& target : targets) {
-    if (target.rfind("data:", 0) == 0) continue;
-    EXPECT_TRUE(fs::exists(page.parent_path() / target)) << page << " links to " << target;
-  }
 }
 
 TEST(CliReport, SampleCampaignTableFiguresAndPages) {
@@ -299,10 +276,10 @@ TEST(CliReport, VideoTrialsGetTheirTracesAndVerificationImages) {
   // its verification image
   ExpectLinksResolve(dir / "report.md", "](", ')', GnuplotOnPath() ? 11 : 8);
   const std::string html = ReadFile(dir / "report.html");
-  EXPECT_EQ(Targets(html, "alt=\"verification image\" src=\"data:image/png;base64,", '"').size(),
+  EXPECT_EQ(LinkTargets(html, "alt=\"verification image\" src=\"data:image/png;base64,", '"').size(),
             2u);
   if (GnuplotOnPath()) {
-    EXPECT_EQ(Targets(html, "alt=\"trial clip", '"').size(), 2u) << "both traces inline";
+    EXPECT_EQ(LinkTargets(html, "alt=\"trial clip", '"').size(), 2u) << "both traces inline";
   } else {
     std::cout << "[  SKIPPED ] traces PNG/SVG checks: gnuplot is not on the PATH\n";
   }

@@ -11,6 +11,7 @@
 #include "liftoff/core/status.h"
 #include "liftoff/synth/spec.h"
 #include "liftoff/synth/trial_writer.h"
+#include "support/short_clip.h"
 #include "support/test_support.h"
 
 namespace liftoff::cli {
@@ -23,27 +24,6 @@ struct VideoCampaign {
   std::string error;
 };
 
-// the LED on at 0.61 s, a 0.4 rad/s ramp from 0.2 s, foot A lifting at 0.47 rad
-inline synth::TrialSpec ShortClipSpec() {
-  synth::TrialSpec spec;
-  spec.id = "clip";
-  spec.seed = 77;
-  spec.duration_s = 2.4;
-  spec.camera.width_px = 640;
-  spec.camera.height_px = 480;
-  spec.camera.fps = 60.0;
-  spec.camera.exposure_s = 1.0 / 120.0;
-  spec.camera.codec = synth::VideoCodec::kH264;
-  spec.led.on_video_s = 0.61;
-  spec.motion.foot = Foot::kA;
-  spec.motion.height.liftoff_rad = 0.47;
-  spec.motion.bend_start_s = 0.0;
-  spec.motion.bend_end_s = 0.15;
-  spec.motion.ramp_start_s = 0.2;
-  spec.motion.ramp_rate_rad_per_s = 0.4;
-  return spec;
-}
-
 /// Writes the clip and DIR/manifest.json: "clip/1", "clip_1" (the clip), then the sample
 /// trials (`hand_trials` of them, logs and times as in samples/trials).
 inline VideoCampaign WriteVideoCampaign(const std::filesystem::path& dir, size_t hand_trials) {
@@ -55,7 +35,7 @@ inline VideoCampaign WriteVideoCampaign(const std::filesystem::path& dir, size_t
     campaign.error = "cannot load the samples' calibration or manifest";
     return campaign;
   }
-  auto written = synth::WriteTrial(ShortClipSpec(), *calibration, dir);
+  auto written = synth::WriteTrial(liftoff::testing::ShortClipSpec("clip"), *calibration, dir);
   if (!written.ok()) {
     campaign.error = written.status().ToString();
     return campaign;

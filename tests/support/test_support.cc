@@ -30,6 +30,32 @@ void ExpectValidSvg(const std::filesystem::path& path) {
   EXPECT_EQ(text.find_first_not_of(" \r\n", close + 6), std::string::npos) << path;
 }
 
+std::vector<std::string> LinkTargets(const std::string& text, std::string_view opening,
+                                     char closing) {
+  // (a search, not std::regex: it recurses per character, and inlined images would
+  // overflow its stack)
+  std::vector<std::string> targets;
+  for (size_t at = text.find(opening); at != std::string::npos; at = text.find(opening, at)) {
+    at += opening.size();
+    const size_t end = text.find(closing, at);
+    if (end == std::string::npos) break;
+    targets.push_back(text.substr(at, end - at));
+  }
+  return targets;
+}
+
+void ExpectLinksResolve(const std::filesystem::path& page, std::string_view opening,
+                        char closing, size_t at_least) {
+  const std::vector<std::string> targets = LinkTargets(ReadFile(page), opening, closing);
+  EXPECT_GE(targets.size(), at_least) << page;
+  for (const std::string& target : targets) {
+    if (target.rfind("data:", 0) == 0 || target.rfind("#", 0) == 0) continue;
+    EXPECT_FALSE(target.rfind("http", 0) == 0) << page << " links outside: " << target;
+    EXPECT_TRUE(std::filesystem::exists(page.parent_path() / target))
+        << page << " links to " << target;
+  }
+}
+
 std::optional<std::filesystem::path> FindOnPath(const std::string& name) {
   std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
   for (std::string folder; std::getline(path, folder, ':');) {

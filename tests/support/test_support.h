@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -23,6 +25,15 @@ std::optional<std::filesystem::path> ReferenceDir();
 void ExpectValidPng(const std::filesystem::path& path);
 /// Expects `path` to hold an SVG document: an <svg> element closed at the end.
 void ExpectValidSvg(const std::filesystem::path& path);
+
+/// The targets of every `opening`...`closing` in `text` (e.g. "](" and ')' for Markdown
+/// links, "src=\"" and '"' for HTML).
+std::vector<std::string> LinkTargets(const std::string& text, std::string_view opening,
+                                     char closing);
+/// Expects `page` to hold at least `at_least` such links and every one to be inline data,
+/// an anchor, or a file beside the page (never a remote address).
+void ExpectLinksResolve(const std::filesystem::path& page, std::string_view opening,
+                        char closing, size_t at_least);
 
 /// The program `name` in a folder of PATH, or nullopt.
 std::optional<std::filesystem::path> FindOnPath(const std::string& name);

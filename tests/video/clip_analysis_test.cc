@@ -20,6 +20,7 @@
 #include "liftoff/synth/spec.h"
 #include "liftoff/synth/trial_writer.h"
 #include "liftoff/video/verification.h"
+#include "support/short_clip.h"
 #include "support/test_support.h"
 
 namespace liftoff::video {
@@ -32,28 +33,9 @@ using liftoff::testing::SourceDir;
 using liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
 
-// A CI-baseline-like clip: 640x480, 60 fps, H.264, the LED on at 0.61 s (between two
-// exposures), a 0.4 rad/s ramp from 0.2 s after it, foot A lifting at 0.47 rad (1 mm at
-// about 2.05 s), 2.4 s long.
-synth::TrialSpec BaseSpec() {
-  synth::TrialSpec spec;
-  spec.id = "clip-base";
-  spec.seed = 77;
-  spec.duration_s = 2.4;
-  spec.camera.width_px = 640;
-  spec.camera.height_px = 480;
-  spec.camera.fps = 60.0;
-  spec.camera.exposure_s = 1.0 / 120.0;
-  spec.camera.codec = synth::VideoCodec::kH264;
-  spec.led.on_video_s = 0.61;
-  spec.motion.foot = Foot::kA;
-  spec.motion.height.liftoff_rad = 0.47;
-  spec.motion.bend_start_s = 0.0;
-  spec.motion.bend_end_s = 0.15;
-  spec.motion.ramp_start_s = 0.2;
-  spec.motion.ramp_rate_rad_per_s = 0.4;
-  return spec;
-}
+// The tests' short clip (support/short_clip.h): the LED on at 0.61 s, foot A's 1 mm at
+// about 2.05 s, 2.4 s long.
+synth::TrialSpec BaseSpec() { return liftoff::testing::ShortClipSpec("clip-base"); }
 
 // The same with the LED on 0.11 s after the recording began: 7 frames before it (the LED
 // detector needs a few dark frames to see a step).

@@ -3,7 +3,9 @@
 // (std::uniform_*_distribution does not promise that).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 
 namespace liftoff {
 
@@ -24,6 +26,12 @@ class SplitMix64 {
   double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }
   /// Uniform in [-1, 1), 53 random bits.
   double Symmetric() { return static_cast<double>(Next() >> 11) * 0x1.0p-52 - 1.0; }
+  /// Standard normal (Box-Muller on two uniforms; the first taken in (0, 1]).
+  double Gaussian() {
+    const double u1 = 1.0 - Uniform();
+    const double u2 = Uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  }
 
  private:
   uint64_t state_;
