@@ -97,6 +97,11 @@ constexpr double kRoiOppositeFrac = 0.5;
 // a codec renewing a tiny LED's block moves many pixels a little either way.
 constexpr double kRoiStrongFrac = 0.3;
 constexpr size_t kSmallLightPx = 6;
+// With an ROI, its outer kBorderPx px are left out of the detection (camera shake carries
+// an edge or a highlight from just outside the ROI into it, where it looks like a light
+// that switched on), narrower in an ROI under 2 * kBorderPx + kMinInnerPx px.
+constexpr int kBorderPx = 3;
+constexpr int kMinInnerPx = 10;
 // With an ROI, each row's flicker gain leaves out pixels brighter than this many times
 // the frame's gain (a light that switched on, not the lamp's flicker, up to +-50 %).
 constexpr double kRowRatioMax = 1.6;
@@ -128,6 +133,18 @@ constexpr double kStrongerFactor = 3.0;
 constexpr size_t kIntervalWindow = 31;
 // Recorded steps per region at most (a region that keeps stepping is no sync LED).
 constexpr size_t kMaxEventsPerRegion = 4096;
+
+// Per pixel of a width_px x height_px ROI: 1 unless within the border band (kBorderPx).
+std::vector<uint8_t> InnerMask(int width_px, int height_px) {
+  const int band = std::clamp((std::min(width_px, height_px) - kMinInnerPx) / 2, 0, kBorderPx);
+  std::vector<uint8_t> inner(static_cast<size_t>(width_px) * static_cast<size_t>(height_px), 0);
+  for (int y = band; y < height_px - band; ++y) {
+    for (int x = band; x < width_px - band; ++x) {
+      inner[static_cast<size_t>(y) * static_cast<size_t>(width_px) + static_cast<size_t>(x)] = 1;
+    }
+  }
+  return inner;
+}
 
 // Every how many of `count` values a quantile looks at (about kQuantileSamples of them).
 size_t SampleStride(size_t count) { return std::max<size_t>(1, count / kQuantileSamples); }
@@ -293,6 +310,7 @@ struct LedDetector::Impl {
   std::vector<float> pixel_reference;
   int64_t reference_frames = 0;
   size_t top_pixels = 0;
+  std::vector<uint8_t> inner;  // per ROI pixel: 1 inside the border band (see kBorderPx)
   std::vector<float> changes;
   std::vector<float> row_gains;  // ring x ROI rows
   std::vector<float> row_ratios;
@@ -495,6 +513,7 @@ Status LedDetector::Impl::Setup(const Frame& frame) {
     regions = 1;
     const auto pixels = static_cast<size_t>(roi.area());
     top_pixels = std::min(pixels, std::max(kTopPixelsMin, pixels / kTopPixelsShare));
+    inner = InnerMask(roi.width, roi.height);
     pixels_per_region = static_cast<double>(top_pixels);
     roi_pictures.assign(static_cast<size_t>(ring) * pixels * 3, 0);
     pixel_reference.assign(pixels, 0.0f);
@@ -701,7 +720,8 @@ double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gai
   for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
     const int brightness = pixel[0] + pixel[1] + pixel[2];
     total += static_cast<uint64_t>(brightness);
-    changes[i] = static_cast<float>(brightness) - gains[i / width] * pixel_reference[i];
+    changes[i] = inner[i] ? static_cast<float>(brightness) - gains[i / width] * pixel_reference[i]
+                          : 0.0f;
   }
   roi_mean_levels = static_cast<double>(total) / (3.0 * static_cast<double>(changes.size()));
   const auto top = static_cast<std::ptrdiff_t>(top_pixels);
@@ -758,6 +778,7 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
     channel_steps[i] = rise ? peak_after - peak_before : peak_before - peak_after;
     lit_peaks[i] = rise ? peak_after : peak_before;
     pixel_wobble[i] = std::abs(static_cast<double>(values[before - 1] - values[before - 2]));
+    if (!inner[i]) pixel_steps[i] = channel_steps[i] = 0.0;
     off_sum += rise ? level_before : level_after;
     on_sum += rise ? level_after : level_before;
   }

@@ -210,6 +210,10 @@ struct TinyLedStream {
   // From the first lit frame on, the 16 x 16 block around the LED renewed by a codec: each
   // pixel of the wall there moves by this many levels up or down (a fixed random pattern).
   double renew_block_levels = 0.0;
+  // Frames [first, last) during which a highlight just left of the ROI (a blurred spot of
+  // +150 levels, 4 px outside) is carried 3 px right, its edge into the ROI's first
+  // columns: a shaken camera or a moving part showing something bright at the border.
+  std::optional<std::pair<int, int>> border_highlight_frames;
   cv::Point led_px{212, 96};
   cv::Rect Roi() const { return cv::Rect(led_px.x - 30, led_px.y - 34, 64, 64); }
   double PeriodNs() const { return 1e9 / fps; }
@@ -253,6 +257,17 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
       picture.row(y) *= gain;
     }
     picture += lit * light;
+    if (stream.border_highlight_frames) {
+      const auto [first, last] = *stream.border_highlight_frames;
+      const bool in = index >= first && index < last;
+      const cv::Point centre(stream.Roi().x - (in ? 1 : 4), stream.Roi().y + 30);
+      for (int dy = -6; dy <= 6; ++dy) {
+        for (int dx = -6; dx <= 6; ++dx) {
+          const auto level = static_cast<float>(150 * std::exp(-(dx * dx + dy * dy) / (2 * 1.5 * 1.5)));
+          picture.at<cv::Vec3f>(centre + cv::Point(dx, dy)) += cv::Vec3f(level, level, level);
+        }
+      }
+    }
     if (lit > 0 && stream.renew_block_levels > 0) {
       const cv::Rect block(stream.led_px.x / 16 * 16, stream.led_px.y / 16 * 16, 16, 16);
       cv::RNG signs(99);
@@ -305,6 +320,24 @@ TEST(LedDetector, FindsTheSwitchOnWhenACodecRenewsTheLedsBlockAroundIt) {
   EXPECT_LE(std::abs(static_cast<double>(result->pulses[0].on_ns) - *stream.on_s * 1e9),
             0.5 * stream.PeriodNs())
       << result->Brief();
+}
+
+// Low light and shake (hard3d-02): a highlight carried across the ROI's border for six
+// frames just before the switch-on is no pulse, and does not hide the switch-on.
+TEST(LedDetector, AHighlightCarriedIntoTheRoisBorderIsNoSwitchOn) {
+  TinyLedStream stream;
+  stream.on_s = 1.5;
+  stream.border_highlight_frames = std::make_pair(38, 44);
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  EXPECT_LE(std::abs(static_cast<double>(result->pulses[0].on_ns) - *stream.on_s * 1e9),
+            0.5 * stream.PeriodNs())
+      << result->Brief();
+  // ... nor a switch-on of its own, with no LED at all
+  stream.on_s.reset();
+  const auto without = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  EXPECT_FALSE(without.ok()) << without->Brief();
 }
 
 TEST(LedDetector, ADroppedFrameAtTheSwitchOnWidensTheIntervalToTheRealTimestamps) {

@@ -19,7 +19,8 @@
 // times its size is found: each pixel's B + G + R against its own reference (an average of
 // the frames that left a ring of the last 5 + min_on_frames, so a step is measured against frames before
 // it), each row's flicker gain taken out first (measured on the same rows beside the ROI, in
-// bands of 4 rows, interpolated: rolling-shutter banding). The signal is the sum of the largest increases (a 256th of the
+// bands of 4 rows, interpolated: rolling-shutter banding), the ROI's outer 3 px left out
+// (shake carries what lies just outside into them). The signal is the sum of the largest increases (a 256th of the
 // ROI's pixels, at least 9) plus the largest decreases. Around a step the ROI's pixels that
 // stepped clearly are the LED's: no light when pixels stepping the other way add up to half
 // as much (an edge moved by shake or a passing part) or when they do not hold their levels;
