@@ -89,6 +89,7 @@ int RunSet(const SynthCommand& command, const Calibration& calibration, std::ost
 synth::CampaignOptions CampaignOptionsFrom(const SynthCommand& command) {
   synth::CampaignOptions options;
   options.trials_per_foot = command.campaign_trials_per_foot;
+  options.seed += command.seed_offset;
   return options;
 }
 
@@ -99,7 +100,8 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
   };
   if (command.set_name != "campaign") {
-    return synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress);
+    return synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress,
+                             command.seed_offset);
   }
   return synth::WriteCampaign(CampaignOptionsFrom(command), calibration, command.output_dir,
                              progress);
@@ -168,6 +170,11 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
       command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);
   }
+  if (command.seed_offset != 0) {
+    err << "liftoff synth: --seed works with --set ci3d, hard3d or campaign (a spec has its "
+           "own seed)\n";
+    return kExitUsage;
+  }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
                                   : RunSet(command, *calibration, out, err);
 }
@@ -182,6 +189,10 @@ Subcommand AddSynthCommand(CLI::App& parent) {
                   "Write a whole named set: ci, paper, ci3d, hard3d or campaign (the 3D camera)");
   app->add_option("--per-foot", command->campaign_trials_per_foot,
                   "--set campaign: trials per foot (1 .. 20)")
+      ->capture_default_str();
+  app->add_option("--seed", command->seed_offset,
+                  "--set ci3d, hard3d or campaign: every clip's seeds offset by this (0: the "
+                  "set as documented; another: its conditions drawn anew)")
       ->capture_default_str();
   app->add_option("--output,-o", command->output_dir, "Folder for the files");
   app->add_flag("--print-spec", command->print_spec, "Print the default spec as JSON");

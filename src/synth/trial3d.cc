@@ -879,9 +879,17 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
 }
 
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
-                                const Calibration& calibration, const Set3dProgress& progress) {
-  LIFTOFF_ASSIGN_OR_RETURN(const std::vector<Trial3dSpec> set, Set3dNamed(name));
-  return WriteSpecs3d(name, set, output_dir, calibration, "", progress);
+                                const Calibration& calibration, const Set3dProgress& progress,
+                                uint64_t seed_offset) {
+  LIFTOFF_ASSIGN_OR_RETURN(std::vector<Trial3dSpec> set, Set3dNamed(name));
+  for (Trial3dSpec& spec : set) {
+    spec.seed += seed_offset;
+    spec.scene.seed += seed_offset;
+  }
+  const std::string description =
+      seed_offset == 0 ? "" : "liftoff synth set " + name + " (" + calibration.name +
+                                  "), seeds offset by " + std::to_string(seed_offset);
+  return WriteSpecs3d(name, set, output_dir, calibration, description, progress);
 }
 
 }  // namespace liftoff::synth

@@ -15,6 +15,7 @@
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 #include "area_resize.h"
+#include "height_curve.h"
 #include "patch_registration.h"
 #include "rise_fit.h"
 #include "video_util.h"
@@ -715,21 +716,6 @@ double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
   return std::isfinite(step) ? step : 0.0;
 }
 
-// How far a codec may have held the foot back, px: its largest catch-up in one frame over
-// frames [first, last] beyond the typical frame-to-frame change (at least kMinLagPx).
-double LagBoundPx(const std::vector<double>& height, size_t first, size_t last) {
-  std::vector<double> changes;
-  double largest = 0;
-  for (size_t f = first + 1; f <= last; ++f) {
-    if (!std::isfinite(height[f]) || !std::isfinite(height[f - 1])) continue;
-    const double change = height[f] - height[f - 1];
-    changes.push_back(std::abs(change));
-    largest = std::max(largest, change);
-  }
-  const double typical = FiniteMedian(changes);
-  return std::max(kMinLagPx, kLagBoundFactor * (largest - (std::isfinite(typical) ? typical : 0.0)));
-}
-
 // The rise for good: the first frame from which the smoothed curve stays above the
 // threshold for kSustainS (or to the clip's end, if that is at least kSustainFrames frames
 // and two thresholds up); the cut: where it then reaches the fit's top. smooth.size() when
@@ -789,7 +775,10 @@ size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector
     // at rest, a wander within the threshold is noise for the robust fit, not a step
     const double allowed = resting ? std::max(tolerance, threshold_px) : tolerance;
     const bool below = levelled_smooth[f] < anchor - allowed;
-    const bool above = levelled_smooth[f] > anchor + allowed;
+    // climbing, the curve may wobble back up (patches lost and found in a fast rise): only
+    // a level above the cut's is another, earlier rise
+    const bool above = levelled_smooth[f] > anchor + allowed &&
+                       (resting || levelled_smooth[f] > smooth[cut]);
     if ((below && resting) || above) {
       const size_t key = lossy && resting ? KeyframeNear(samples, f, half) : 0;
       if (key == 0) break;
@@ -864,7 +853,14 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   fit_options.threshold = threshold_px;
   const bool may_lag = std::find(lag_free.begin(), lag_free.end(), false) != lag_free.end();
   if (may_lag) {
-    fit_options.lag_bound = LagBoundPx(height, start, std::max(cut, cut_with_key));
+    // the catch-ups up to the fit's top, and the key frame's (higher up, where a fast rise
+    // is tracked less well, other jumps are no codec's)
+    fit_options.lag_bound = internal::LagBoundPx(height, start, cut, kMinLagPx, kLagBoundFactor);
+    if (cut_with_key > cut && cut_with_key + 1 < height.size()) {
+      fit_options.lag_bound = std::max(fit_options.lag_bound,
+                                       internal::LagBoundPx(height, cut_with_key - 2, cut_with_key + 1, kMinLagPx,
+                                                           kLagBoundFactor));
+    }
     fit_options.lag_weight = kLagWeight;
   }
   search.lag_bound_px = fit_options.lag_bound;
@@ -886,28 +882,6 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   return search;
 }
 
-// Where a line through the 5 frames around the curve's first sustained crossing of `level`
-// (frames [first, last]) crosses it, s; NaN when it does not.
-double LocalCrossingS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
-                      size_t first, size_t last, double level) {
-  size_t at = last + 1;
-  for (size_t f = first; f + 2 <= last && at > last; ++f) {
-    if (height[f] >= level && height[f + 1] >= level && height[f + 2] >= level) at = f;
-  }
-  if (at > last || at < first + 2) return kNaNd;
-  double st = 0, sh = 0, stt = 0, sth = 0, n = 0;
-  const double origin_s = Seconds(samples[at].t_ns);
-  for (size_t f = at - 2; f <= at + 2 && f <= last; ++f) {
-    if (!std::isfinite(height[f])) continue;
-    const double t = Seconds(samples[f].t_ns) - origin_s;
-    st += t, sh += height[f], stt += t * t, sth += t * height[f], n += 1;
-  }
-  const double slope = (n * sth - st * sh) / (n * stt - st * st);
-  if (!(slope > 0)) return kNaNd;
-  const double intercept = (sh - slope * st) / n;
-  return origin_s + (level - intercept) / slope;
-}
-
 // The frames either side of t_ns and the instant with its uncertainty.
 TimedEvent MakeEvent(const std::vector<HeightSample>& samples, double t_s, double uncertainty_s) {
   TimedEvent event;
@@ -927,10 +901,11 @@ std::string PatchCount(size_t count) {
 
 // The liftoff instant's half-width, s, in quadrature: the spread of the acceptable knees'
 // crossings, a codec's lag (up to the bound allowed for, at least compression_error_px),
-// the registration's own error, the rest noise and, with an estimated scale, 3 % of the
-// threshold, each over the model's rise rate at the crossing.
+// the registration's own error, the rest noise, the ground's drift and, with an estimated
+// scale, 3 % of the threshold, each over the model's rise rate at the crossing.
 double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
-                           double crossing_s, double compression_error_px) {
+                           double crossing_s, double compression_error_px,
+                           double ground_drift_px) {
   const internal::RiseFit& fit = search.fit;
   const double fit_spread =
       std::max(crossing_s - fit.crossing_low_s, fit.crossing_high_s - crossing_s);
@@ -942,7 +917,8 @@ double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
       track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px : 0.0;
   const double px = std::sqrt(lag_px * lag_px + scale_px * scale_px +
                               kRegistrationErrorPx * kRegistrationErrorPx +
-                              track.rest_noise_px * track.rest_noise_px);
+                              track.rest_noise_px * track.rest_noise_px +
+                              ground_drift_px * ground_drift_px);
   return std::hypot(fit_spread, px / rate);
 }
 
@@ -1095,21 +1071,60 @@ void FillSamples(const PatchSelection& selection, const std::vector<size_t>& res
   track.rest_noise_px = RobustSpread(rest_heights);
 }
 
+// The model's crossing checked against the curve's own (internal::CheckCrossing). Returns
+// why it was replaced, or "" when the model held.
+std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
+                                 const std::vector<double>& height, const LiftoffSearch& search,
+                                 const FootTrack& track, double& crossing_s,
+                                 double& uncertainty_s) {
+  const internal::CurveCheck check =
+      internal::CheckCrossing(samples, height, search.fit_first, search.fit_last,
+                              search.fit.level + track.threshold_px, crossing_s, uncertainty_s);
+  if (!check.disagreed) return "";
+  const std::string why = "the rise model crossed the threshold at " +
+                          FormatFixed(crossing_s, 3) + " s, after the curve itself (" +
+                          FormatFixed(check.crossing_s, 3) + " s): the curve's crossing is taken";
+  crossing_s = check.crossing_s;
+  uncertainty_s = check.uncertainty_s;
+  return why;
+}
+
+// How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
+// the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
+// a drift that comes with the rise is a shadow or a part of the robot among the ground
+// patches, and moves the height curve by as much.
+double GroundDriftPx(const std::vector<HeightSample>& samples, const std::vector<double>& shake_px,
+                     const std::vector<size_t>& rest, double crossing_s) {
+  std::vector<double> at_rest, at_crossing;
+  for (size_t f : rest) at_rest.push_back(shake_px[f]);
+  for (size_t f = 0; f < samples.size(); ++f) {
+    if (std::abs(Seconds(samples[f].t_ns) - crossing_s) <= kSmoothHalfS) {
+      at_crossing.push_back(shake_px[f]);
+    }
+  }
+  const double drift = FiniteMedian(at_crossing) - FiniteMedian(at_rest);
+  return std::isfinite(drift) ? std::abs(drift) : 0.0;
+}
+
 // The liftoff instant and its onset from the search. With a codec's lag the fit only
 // bounds the instant: its middle; without, the curve itself is exact to noise, and a line
 // through the frames around its crossing beats the model's two terms (when it lies inside
 // the model's interval).
 void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& selection,
-                const LiftoffSearch& search, double compression_error_px, FootTrack& track) {
+                const std::vector<size_t>& rest, const LiftoffSearch& search,
+                double compression_error_px, FootTrack& track) {
   const internal::RiseFit& fit = search.fit;
   double crossing_s = search.lag_bound_px > 0 ? fit.crossing_middle_s : fit.crossing_s;
   if (search.lag_bound_px == 0 && track.rest_noise_px < kLocalCrossingNoisePx) {
-    const double local_s = LocalCrossingS(samples, selection.height_px, search.fit_first,
+    const double local_s = internal::LocalCrossingS(samples, selection.height_px, search.fit_first,
                                           search.fit_last, fit.level + track.threshold_px);
     if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
   }
-  const double uncertainty_s =
-      LiftoffUncertaintyS(track, search, crossing_s, compression_error_px);
+  const double drift_px = GroundDriftPx(samples, selection.shake_px, rest, crossing_s);
+  double uncertainty_s =
+      LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
+  const std::string disagreed =
+      CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
   track.above_threshold =
       MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
@@ -1119,6 +1134,10 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.fit_last_frame = samples[search.fit_last].frame_index;
   track.fit_noise_px = fit.noise;
   AddConfidenceWarnings(track, selection, fit, uncertainty_s);
+  if (!disagreed.empty()) {
+    track.warnings.push_back("low confidence: " + disagreed);
+    track.low_confidence = true;
+  }
 }
 
 }  // namespace
@@ -1164,7 +1183,7 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
                                            o.compression_error_px > 0);
   track.max_rise_px = search.max_rise_px;
   if (!search.not_found.empty()) return NotFoundError(search.not_found);
-  SetLiftoff(samples, selection, search, o.compression_error_px, track);
+  SetLiftoff(samples, selection, rest, search, o.compression_error_px, track);
   if (o.tape_colour) {
     track.located_by_tape = ShowsTapeColour(s.patches, selection.foot, *o.tape_colour);
     if (!track.located_by_tape) {

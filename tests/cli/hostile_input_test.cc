@@ -289,6 +289,8 @@ const std::vector<HostileCase>& Cases() {
        "sync @/A1.csv --led-on 1 --liftoff 2 --max-bad-lines -1", 3, {"--max-bad-lines"}},
       {"table with a negative --max-bad-lines", OneTrial,
        "table @/manifest.json --max-bad-lines -1", 3, {"--max-bad-lines"}},
+      {"synth --seed with a 2D set", nullptr, "synth --set ci --seed 3 -o @/set", 2,
+       {"--seed", "ci3d, hard3d or campaign"}},
       {"sim sweep --hardware of a missing manifest", nullptr,
        "sim sweep --hardware @/missing.json --progress off", 4, {"--hardware", "missing.json"},
        {"s wall"}},  // failed before the sweep, not after it

@@ -24,6 +24,7 @@ struct SynthCommand {
   std::string set_name;
   /// --set campaign: trials per foot (CampaignOptions::trials_per_foot).
   int campaign_trials_per_foot = 5;
+  uint64_t seed_offset = 0;  ///< --seed: the 3D sets' seeds offset by it
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.

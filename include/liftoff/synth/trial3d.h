@@ -212,8 +212,11 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
                                   const std::filesystem::path& output_dir,
                                   const Calibration& calibration, const std::string& description,
                                   const Set3dProgress& progress = {});
-/// The named set (Set3dNamed) through WriteSpecs3d.
+/// The named set (Set3dNamed) through WriteSpecs3d, every clip's seeds (its noise, shake,
+/// drops, floor and clutter) offset by `seed_offset` (0: the set as documented; another:
+/// the same conditions drawn anew, to test on footage the detectors were not tuned on).
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
-                                const Calibration& calibration, const Set3dProgress& progress = {});
+                                const Calibration& calibration, const Set3dProgress& progress = {},
+                                uint64_t seed_offset = 0);
 
 }  // namespace liftoff::synth

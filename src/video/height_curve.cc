@@ -1,0 +1,88 @@
+#include "height_curve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace liftoff::video::internal {
+namespace {
+
+double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
+
+}  // namespace
+
+double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
+                  double min_lag_px, double factor) {
+  const auto change = [&](size_t f) {
+    const double c = height[f] - height[f - 1];
+    return std::isfinite(c) ? c : 0.0;
+  };
+  double largest = 0;
+  for (size_t f = first + 1; f <= last; ++f) {
+    const double before = f >= first + 2 ? change(f - 1) : 0.0;
+    const double after = f + 1 <= last ? change(f + 1) : 0.0;
+    largest = std::max(largest, change(f) - std::max({0.0, before, after}));
+  }
+  return std::max(min_lag_px, factor * largest);
+}
+
+size_t SustainedCrossing(const std::vector<double>& height, size_t first, size_t last,
+                         double level) {
+  for (size_t f = first; f + 2 <= last; ++f) {
+    if (height[f] >= level && height[f + 1] >= level && height[f + 2] >= level) return f;
+  }
+  return last + 1;
+}
+
+size_t FinalRunStart(const std::vector<double>& height, size_t first, size_t last, double level) {
+  if (!(height[last] >= level)) return last + 1;
+  size_t f = last;
+  while (f > first && !(height[f - 1] < level)) --f;
+  return f;
+}
+
+double LineCrossingS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                     size_t at, size_t first, size_t last, double level) {
+  if (at > last || at < first + 2) return std::numeric_limits<double>::quiet_NaN();
+  double st = 0, sh = 0, stt = 0, sth = 0, n = 0;
+  const double origin_s = Seconds(samples[at].t_ns);
+  for (size_t f = at - 2; f <= at + 2 && f <= last; ++f) {
+    if (!std::isfinite(height[f])) continue;
+    const double t = Seconds(samples[f].t_ns) - origin_s;
+    st += t, sh += height[f], stt += t * t, sth += t * height[f], n += 1;
+  }
+  const double slope = (n * sth - st * sh) / (n * stt - st * st);
+  if (!(slope > 0)) return std::numeric_limits<double>::quiet_NaN();
+  const double intercept = (sh - slope * st) / n;
+  return origin_s + (level - intercept) / slope;
+}
+
+double LocalCrossingS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                      size_t first, size_t last, double level) {
+  return LineCrossingS(samples, height, SustainedCrossing(height, first, last, level), first,
+                       last, level);
+}
+
+CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,
+                         const std::vector<double>& height, size_t first, size_t last,
+                         double level, double model_s, double model_uncertainty_s) {
+  CurveCheck check;
+  const size_t above = FinalRunStart(height, first, last, level);
+  if (above > last || above == 0) return check;
+  const double above_s = Seconds(samples[above].t_ns);
+  if (!(model_s - model_uncertainty_s > above_s)) return check;
+  const double before_s = Seconds(samples[above - 1].t_ns);
+  double curve_s = LineCrossingS(samples, height, above, first, last, level);
+  if (!(curve_s >= before_s && curve_s <= above_s)) {
+    const double from = height[above - 1], to = height[above];
+    curve_s = std::isfinite(from) && to > from
+                  ? before_s + (above_s - before_s) * (level - from) / (to - from)
+                  : above_s;
+  }
+  check.disagreed = true;
+  check.crossing_s = curve_s;
+  check.uncertainty_s = std::max(model_uncertainty_s, above_s - before_s);
+  return check;
+}
+
+}  // namespace liftoff::video::internal
