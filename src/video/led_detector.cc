@@ -123,6 +123,13 @@ constexpr double kFlatFracPixels = 0.2;
 // The frames after a step may go on in its direction by at most this fraction of it (a
 // codec refines a small bright spot over a few frames), during its confirmation too.
 constexpr double kCreepFrac = 0.5;
+// With an ROI, a step whose contrast does not stand out from the frame's (a codec renewed
+// much of the picture at that frame) still counts when its largest pixel step is at least
+// this many times the 90th percentile of the ROI's pixel steps (at least kStandoutFloor, a
+// grey level in each channel): a frame-wide change moves the ROI's other pixels as much,
+// a light only its own.
+constexpr double kLocalStandout = 4.0;
+constexpr double kStandoutFloor = 3.0;
 // The LED's contrast with an ROI: the brightest-channel step of its pixel of this rank
 // (0: the largest; 2 ignores two noisy pixels and keeps a light of 3 px).
 constexpr size_t kContrastRank = 2;
@@ -218,6 +225,7 @@ struct StepEvent {
   // (the lit level may be higher still: a partly lit frame may have been less lit)
   double creep = 0.0;
   double contrast_levels = 0.0;  // brightest channel step
+  double standout = 0.0;  // with an ROI: largest pixel step over the ROI's usual (kLocalStandout)
   double off_levels = 0.0, on_levels = 0.0;  // the region's mean, grey levels
   int64_t period_ns = 0;         // usual frame interval at the time
   std::vector<int64_t> index, t_ns;
@@ -411,6 +419,8 @@ struct LedDetector::Impl {
   // clipped). False when the step does not look like a light: pixels stepping the other
   // way by a good part of it (an edge moved by camera shake or a passing part).
   bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event);
+  // the quantile q of |pixel_steps| over the ROI's inner pixels
+  double InnerQuantile(double q);
 
   int64_t PeriodNs() const;
 
@@ -800,6 +810,7 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
     return false;
   }
   event.clipped = unclipped < kUnclippedShare * stepped;
+  event.standout = largest / std::max(kStandoutFloor, InnerQuantile(kOutlierQuantile));
   // the dating dating_series and the LED's contrast over the chosen pixels
   std::fill(dating_series.begin(), dating_series.end(), 0.0);
   std::vector<double> contrasts;
@@ -830,6 +841,14 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
   event.off_levels = off_sum / (3.0 * static_cast<double>(pixels));
   event.on_levels = on_sum / (3.0 * static_cast<double>(pixels));
   return true;
+}
+
+double LedDetector::Impl::InnerQuantile(double q) {
+  jumps.clear();
+  for (size_t i = 0; i < pixel_steps.size(); ++i) {
+    if (inner[i]) jumps.push_back(std::abs(pixel_steps[i]));
+  }
+  return jumps.empty() ? 0.0 : QuantileOf(jumps, q);
 }
 
 int64_t LedDetector::Impl::PeriodNs() const {
@@ -973,7 +992,7 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   if (!located && !MeasureRoiStep(k, rise, event)) return;
   const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
   if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
-  if (contrast < outlier_contrast) return;
+  if (contrast < outlier_contrast && (located || event.standout < kLocalStandout)) return;
   if (contrast < options.min_contrast_levels) {
     if (rise && contrast > rejected_contrast) {
       rejected_contrast = contrast;
@@ -1048,8 +1067,10 @@ void LedDetector::Impl::Confirm(size_t slot) {
     const double held = event.rise ? event.signal_on : event.signal_off;
     const double left = event.rise ? event.signal_off : event.signal_on;
     const double beyond = (event.rise ? 1.0 : -1.0) * (value - held);
+    // (with an ROI a light may go on brightening for good: a codec refines a tiny LED's
+    // spot over several frames, sometimes by more than the step itself)
     const bool holds = std::abs(value - held) <= tolerance ||
-                       (beyond > 0 && beyond <= kCreepFrac * event.signal_step);
+                       (beyond > 0 && (!located || beyond <= kCreepFrac * event.signal_step));
     bool done = false;
     if (std::abs(value - left) <= tolerance) {
       done = true;  // back already: a short pulse

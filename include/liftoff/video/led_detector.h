@@ -44,8 +44,9 @@
 // step) are flat compared with the step, it crosses threshold_frac of the way in one frame
 // (or two), the LED's contrast reaches min_contrast_levels, the step stands out from what
 // the rest of the frame did at that instant (codec key frames, lighting changes and shake
-// step many regions at once), and the signal then holds its new level, or returns to the
-// old one, for 8 more frames. A region's steps under half the contrast of its brightest
+// step many regions at once; with an ROI, a step whose largest pixel step is 4 times the
+// ROI's usual one stands out however the frame changed), and the signal then holds its
+// new level (with an ROI, or goes on rising), or returns to the old one, for 8 more frames. A region's steps under half the contrast of its brightest
 // switch-on are not pulses. Limits: in an ROI where no LED ever lights, a codec's update of
 // a still block by a few grey levels can pass for a dim LED; a small, dim LED under strong
 // camera shake is missed rather than mistaken; located, a 1 px LED under flicker and shake
