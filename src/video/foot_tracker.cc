@@ -23,6 +23,8 @@
 namespace liftoff::video {
 namespace {
 
+using internal::FiniteMedian;
+
 using internal::MedianOf;
 using internal::PatchMatch;
 using internal::PatchTemplate;
@@ -105,6 +107,13 @@ constexpr size_t kFewGroundPatches = 3;
 constexpr double kNoisyFraction = 0.5;
 constexpr double kWideUncertaintyS = 0.25;
 constexpr double kShortRiseThresholds = 3.0;
+// A key frame between still stretches of this long (and this many frames at least), each
+// within this many thresholds, renews the picture's quality only.
+constexpr double kQuietS = 0.15;
+constexpr size_t kQuietFrames = 5;
+constexpr double kQuietThresholds = 0.1;
+// A curve this many thresholds below rest before its rise measures more than the foot.
+constexpr double kSunkThresholds = 2.0;
 // The height curve's own error, px: a registration reads a sharp edge moved by a fraction
 // of a pixel with a sawtooth error (~0.1 px on the 2D renderer's row-blended sprite), and a
 // shaken camera adds to it (0.16 px rms under 1 px-a-frame shake: foot_tracker_test).
@@ -121,14 +130,6 @@ int64_t RoundNs(double value) { return static_cast<int64_t>(std::llround(value))
 double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 std::string MsText(int64_t t_ns) { return FormatFixed(static_cast<double>(t_ns) / 1e6, 1); }
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-// Median of the finite values; NaN for none.
-double FiniteMedian(std::vector<double>& values) {
-  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-               values.end());
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
-}
 
 }  // namespace
 
@@ -706,16 +707,6 @@ size_t KeyframeNear(const std::vector<HeightSample>& samples, size_t f, size_t h
   return 0;
 }
 
-// The curve's step at frame `key`: the median of `count` frames from it less that of the
-// `count` before it.
-double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
-  std::vector<double> after, before;
-  for (size_t g = key; g < std::min(curve.size(), key + count); ++g) after.push_back(curve[g]);
-  for (size_t g = key - std::min(key, count); g < key; ++g) before.push_back(curve[g]);
-  const double step = FiniteMedian(after) - FiniteMedian(before);
-  return std::isfinite(step) ? step : 0.0;
-}
-
 // The rise for good: the first frame from which the smoothed curve stays above the
 // threshold for kSustainS (or to the clip's end, if that is at least kSustainFrames frames
 // and two thresholds up); the cut: where it then reaches the fit's top. smooth.size() when
@@ -782,7 +773,7 @@ size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector
     if ((below && resting) || above) {
       const size_t key = lossy && resting ? KeyframeNear(samples, f, half) : 0;
       if (key == 0) break;
-      const double step = LevelStep(levelled, key, 2 * half + 1);
+      const double step = internal::LevelStep(levelled, key, 2 * half + 1);
       for (size_t g = first; g < key; ++g) {
         levelled[g] += step;
         levelled_smooth[g] += step;
@@ -820,21 +811,18 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                        FormatFixed(kSustainS, 1) + " s";
     return search;
   }
-  size_t cut_with_key = 0;
-  // a key frame soon after the cut shows the foot without lag: fit up to it, unless the
-  // foot has gone far beyond the fit's top by then (a fast rise the model cannot follow;
-  // not known in the clip's last frames, where the running median sees only the past)
-  for (size_t f = cut + 1; f + smooth_half < smooth.size(); ++f) {
-    if (Seconds(samples[f].t_ns - samples[cut].t_ns) > kKeyframeReachS) break;
-    if (!(smooth[f] <= kKeyframeReachTops * smooth[cut])) break;
-    if (lossy && samples[f].keyframe && std::isfinite(height[f])) {
-      cut_with_key = f;
-      break;
-    }
-  }
+  const size_t cut_with_key =
+      lossy ? internal::ReachKeyframe(samples, height, smooth, cut, smooth_half, threshold_px,
+                                      kKeyframeReachS, kKeyframeReachTops)
+            : 0;
   std::vector<double> levelled = height;
   const size_t start = FindRestStart(samples, smooth, first, cut, threshold_px, rest_noise_px,
                                      lossy, levelled);
+  if (lossy) {
+    internal::LevelQuietKeyframes(samples, start, cut,
+                                  std::max(kQuietFrames, FramesIn(samples, kQuietS)),
+                                  kQuietThresholds * threshold_px, levelled);
+  }
   // the model over the stretch (raw heights: the fit is robust to single frames)
   // a lossy codec may hold slow motion back: a predicted frame until the picture is renewed,
   // an intra-only codec (MJPEG) by quantising an edge's sub-pixel position; a key frame
@@ -1089,6 +1077,27 @@ std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
   return why;
 }
 
+// A foot does not sink into the ground: a curve that goes below the rest level by more than
+// kSunkThresholds thresholds before its rise measures more than the foot (a leg tilting
+// as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
+// known to lie between the curve's last frame within a threshold of rest and the crossing:
+// the uncertainty reaches back to it. Returns why, or "" when the curve did not sink.
+std::string CheckSinking(const std::vector<HeightSample>& samples,
+                         const std::vector<double>& height, const LiftoffSearch& search,
+                         const FootTrack& track, double crossing_s, double& uncertainty_s) {
+  size_t at = search.fit_first;
+  while (at < search.fit_last && Seconds(samples[at].t_ns) < crossing_s) ++at;
+  const double level = track.rest_rise_px, threshold = track.threshold_px;  // the rest window's
+  const internal::Sinking sank = internal::SankBefore(samples, height, search.fit_first, at, level,
+                                                      threshold, kSunkThresholds * threshold);
+  if (!sank.sank) return "";
+  uncertainty_s = std::max(uncertainty_s, crossing_s - sank.rest_s);
+  return "the height curve sank " + FormatFixed(sank.depth_px / threshold, 1) +
+         " thresholds below rest before its rise (a tilting leg or a shadow among the foot's "
+         "patches): the liftoff lies between " +
+         FormatFixed(sank.rest_s, 3) + " s and the crossing";
+}
+
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
 // the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
 // a drift that comes with the rise is a shadow or a part of the robot among the ground
@@ -1125,6 +1134,8 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
       LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
+  const std::string sank =
+      CheckSinking(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
   track.above_threshold =
       MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
@@ -1134,8 +1145,9 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.fit_last_frame = samples[search.fit_last].frame_index;
   track.fit_noise_px = fit.noise;
   AddConfidenceWarnings(track, selection, fit, uncertainty_s);
-  if (!disagreed.empty()) {
-    track.warnings.push_back("low confidence: " + disagreed);
+  for (const std::string& why : {disagreed, sank}) {
+    if (why.empty()) continue;
+    track.warnings.push_back("low confidence: " + why);
     track.low_confidence = true;
   }
 }

@@ -4,12 +4,62 @@
 #include <cmath>
 #include <limits>
 
+#include "video_util.h"
+
 namespace liftoff::video::internal {
 namespace {
 
 double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
 }  // namespace
+
+double FiniteMedian(std::vector<double>& values) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
+}
+
+double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
+  std::vector<double> after, before;
+  for (size_t g = key; g < std::min(curve.size(), key + count); ++g) after.push_back(curve[g]);
+  for (size_t g = key - std::min(key, count); g < key; ++g) before.push_back(curve[g]);
+  const double step = FiniteMedian(after) - FiniteMedian(before);
+  return std::isfinite(step) ? step : 0.0;
+}
+
+void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start, size_t cut,
+                         size_t frames, double quiet_px, std::vector<double>& levelled) {
+  const auto holds = [&](size_t from, size_t to) {  // frames [from, to)
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (size_t f = from; f < to; ++f) {
+      if (!std::isfinite(levelled[f])) return false;
+      low = std::min(low, levelled[f]);
+      high = std::max(high, levelled[f]);
+    }
+    return high - low <= quiet_px;
+  };
+  for (size_t key = start + frames; key + frames <= cut; ++key) {
+    if (!samples[key].keyframe) continue;
+    if (!holds(key - frames, key) || !holds(key, key + frames)) continue;
+    const double step = LevelStep(levelled, key, frames);
+    for (size_t f = start; f < key; ++f) levelled[f] += step;
+  }
+}
+
+size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                     const std::vector<double>& smooth, size_t cut, size_t smooth_half,
+                     double threshold_px, double reach_s, double reach_tops) {
+  double highest = height[cut];
+  for (size_t f = cut + 1; f + smooth_half < smooth.size(); ++f) {
+    if (Seconds(samples[f].t_ns - samples[cut].t_ns) > reach_s) break;
+    if (!(smooth[f] <= reach_tops * smooth[cut])) break;
+    if (height[f] < highest - threshold_px) break;
+    if (std::isfinite(height[f])) highest = std::max(highest, height[f]);
+    if (samples[f].keyframe && std::isfinite(height[f])) return f;
+  }
+  return 0;
+}
 
 double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
                   double min_lag_px, double factor) {
@@ -61,6 +111,28 @@ double LocalCrossingS(const std::vector<HeightSample>& samples, const std::vecto
                       size_t first, size_t last, double level) {
   return LineCrossingS(samples, height, SustainedCrossing(height, first, last, level), first,
                        last, level);
+}
+
+Sinking SankBefore(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                   size_t first, size_t at, double rest_level, double threshold_px,
+                   double sunk_px) {
+  Sinking sinking;
+  double lowest = rest_level;
+  size_t deepest = at;
+  for (size_t f = first; f < at; ++f) {
+    if (std::isfinite(height[f]) && height[f] < lowest) {
+      lowest = height[f];
+      deepest = f;
+    }
+  }
+  if (!(lowest < rest_level - sunk_px)) return sinking;
+  // back from the deepest frame (the curve passes rest again on its way up)
+  size_t rest = deepest;
+  while (rest > first && !(std::abs(height[rest - 1] - rest_level) <= threshold_px)) --rest;
+  sinking.sank = true;
+  sinking.depth_px = rest_level - lowest;
+  sinking.rest_s = Seconds(samples[rest > 0 ? rest - 1 : 0].t_ns);
+  return sinking;
 }
 
 CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,

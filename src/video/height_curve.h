@@ -11,6 +11,33 @@
 
 namespace liftoff::video::internal {
 
+/// Median of the finite values (reorders and shortens `values`); NaN for none.
+double FiniteMedian(std::vector<double>& values);
+
+/// The curve's step at frame `key`: the median of the `count` frames from it less that of
+/// the `count` before it (0 where either has no finite value).
+double LevelStep(const std::vector<double>& curve, size_t key, size_t count);
+
+/// A key frame between still stretches renews the picture's quality, not the foot's place:
+/// for each key frame among frames (start, cut] where the `frames` frames before it and the
+/// `frames` from it on each hold within `quiet_px`, the frames from `start` to it are
+/// levelled with those after (a lag-free key frame weighs as many samples, so its small
+/// offset would pull the rise model's knee to it). A key frame with the rise going on after
+/// it is left alone: its step may be a codec's catch-up.
+void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start, size_t cut,
+                         size_t frames, double quiet_px, std::vector<double>& levelled);
+
+/// The key frame soon after the fit's top (frame `cut`) that shows the foot without a
+/// codec's lag, to extend the fit to: the first within reach_s of it while the running
+/// median `smooth` stays within reach_tops times its value at the cut (a fast rise the model
+/// cannot follow), the clip's last smooth_half frames excepted (their running median sees
+/// only the past), and before the curve falls back by threshold_px from its highest since
+/// the cut (a key frame renews a lagging picture upwards: a fall is the tracker losing the
+/// foot). 0 for none.
+size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                     const std::vector<double>& smooth, size_t cut, size_t smooth_half,
+                     double threshold_px, double reach_s, double reach_tops);
+
 /// How far a codec may have held the curve back over frames [first, last], px: its largest
 /// change in one frame beyond the larger of the changes either side of it (a frame held
 /// back changes by nothing and the next catches up; a fast rise changes by much in every
@@ -36,6 +63,21 @@ double LineCrossingS(const std::vector<HeightSample>& samples, const std::vector
 /// LineCrossingS around the curve's first sustained crossing of `level`.
 double LocalCrossingS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                       size_t first, size_t last, double level);
+
+/// Whether the curve sank before frame `at`, and since when.
+struct Sinking {
+  bool sank = false;
+  double depth_px = 0.0;  ///< how far below the rest level it went
+  double rest_s = 0.0;    ///< its last frame within threshold_px of rest before sinking, s
+};
+
+/// A foot does not sink into the ground: a curve that goes below `rest_level` by more than
+/// sunk_px among frames [first, at) measures more than the foot (a leg tilting as the robot
+/// starts to tip, a shadow on the foot's patches), and the liftoff is only known to lie
+/// after its last frame within threshold_px of rest before the deepest one.
+Sinking SankBefore(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                   size_t first, size_t at, double rest_level, double threshold_px,
+                   double sunk_px);
 
 /// The model's crossing of `level` checked against the curve over frames [first, last].
 struct CurveCheck {

@@ -18,6 +18,7 @@ std::vector<HeightSample> Samples(size_t count) {
   for (size_t i = 0; i < count; ++i) {
     samples[i].frame_index = static_cast<int64_t>(i);
     samples[i].t_ns = static_cast<int64_t>(std::llround(static_cast<double>(i) * kFrameS * 1e9));
+    samples[i].keyframe = false;
   }
   return samples;
 }
@@ -75,6 +76,71 @@ TEST(CheckCrossing, AModelCrossingWhollyAfterTheCurveIsReplacedByTheCurves) {
   const CurveCheck certain = CheckCrossing(samples, height, 0, 24, 0.57, 22 * kFrameS, 0.001);
   ASSERT_TRUE(certain.disagreed);
   EXPECT_NEAR(certain.uncertainty_s, kFrameS, 1e-9);
+}
+
+TEST(QuietKeyframes, AKeyFramesStepBetweenStillStretchesIsLevelledAndACatchUpIsNot) {
+  // still at 0, a key frame at 10 renews the picture to +0.1 px, still again, then at frame
+  // 20 another key frame steps +0.1 with the rise going on after it (a catch-up)
+  std::vector<double> height(30, 0.0);
+  for (size_t f = 10; f < 20; ++f) height[f] = 0.1;
+  for (size_t f = 20; f < 30; ++f) height[f] = 0.2 + 0.1 * static_cast<double>(f - 20);
+  std::vector<HeightSample> samples = Samples(height.size());
+  samples[10].keyframe = samples[20].keyframe = true;
+  std::vector<double> levelled = height;
+  LevelQuietKeyframes(samples, 0, 29, 5, 0.05, levelled);
+  for (size_t f = 0; f < 20; ++f) EXPECT_NEAR(levelled[f], 0.1, 1e-12) << "frame " << f;
+  for (size_t f = 20; f < 30; ++f) EXPECT_EQ(levelled[f], height[f]) << "frame " << f;
+  // a step the still stretches do not hold within quiet_px is no renewal
+  std::vector<double> noisy = height;
+  noisy[12] = 0.2;
+  std::vector<double> kept = noisy;
+  LevelQuietKeyframes(samples, 0, 29, 5, 0.05, kept);
+  EXPECT_EQ(kept, noisy);
+}
+
+TEST(ReachKeyframe, TheFirstKeyFrameAfterTheTopUnlessTheCurveFellBackOrOutgrewTheReach) {
+  // the top at frame 10 (2 px), rising 0.5 px a frame; key frames at 13 and 16
+  std::vector<double> height(30);
+  for (size_t f = 0; f < height.size(); ++f) height[f] = 0.5 * (static_cast<double>(f) - 6);
+  std::vector<HeightSample> samples = Samples(height.size());
+  samples[13].keyframe = samples[16].keyframe = true;
+  EXPECT_EQ(ReachKeyframe(samples, height, height, 10, 2, 0.5, 1.0, 3.0), 13u);
+  // out of reach in time (13 is 0.12 s after the top) or in height (3.5 px > 1.5 x 2 px)
+  EXPECT_EQ(ReachKeyframe(samples, height, height, 10, 2, 0.5, 0.1, 3.0), 0u);
+  EXPECT_EQ(ReachKeyframe(samples, height, height, 10, 2, 0.5, 1.0, 1.5), 0u);
+  // the tracker loses the foot at 12: the key frames after it anchor nothing (re-drawn
+  // hard3d-01: a key frame at 7 px while the frames before it read 14 and 19 px)
+  std::vector<double> lost = height;
+  for (size_t f = 12; f < lost.size(); ++f) lost[f] = 1.0;
+  EXPECT_EQ(ReachKeyframe(samples, lost, height, 10, 2, 0.5, 1.0, 3.0), 0u);
+  // a dip of less than the threshold is noise
+  std::vector<double> wobbly = height;
+  wobbly[12] = height[11] - 0.4;
+  EXPECT_EQ(ReachKeyframe(samples, wobbly, height, 10, 2, 0.5, 1.0, 3.0), 13u);
+}
+
+TEST(SankBefore, ACurveBelowRestBeforeItsRiseIsNotTheFootAlone) {
+  // at rest (0) to frame 9, sinking to -2 px by frame 14 (a tilting leg: re-drawn hard3d-06),
+  // the rise crossing +0.5 at frame 16
+  const std::vector<double> height = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -0.3, -0.8, -1.2, -1.6,
+                                      -2.0, -0.5, 0.6, 1.5};
+  const std::vector<HeightSample> samples = Samples(height.size());
+  const Sinking sank = SankBefore(samples, height, 0, 16, 0.0, 0.5, 1.0);
+  ASSERT_TRUE(sank.sank);
+  EXPECT_NEAR(sank.depth_px, 2.0, 1e-12);
+  EXPECT_NEAR(sank.rest_s, 10 * kFrameS, 1e-9);  // -0.3 at frame 10 is within 0.5 of rest
+  // sinking by less than sunk_px is noise
+  EXPECT_FALSE(SankBefore(samples, height, 0, 16, 0.0, 0.5, 2.5).sank);
+  EXPECT_FALSE(SankBefore(samples, height, 0, 10, 0.0, 0.5, 1.0).sank);
+}
+
+TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> curve = {1, 1, 5, 1, 2, 2, nan, 9, 2};
+  EXPECT_EQ(LevelStep(curve, 4, 4), 1.0);  // median {2, 2, 9, 2} - median {1, 1, 5, 1}
+  EXPECT_EQ(LevelStep(std::vector<double>(4, nan), 2, 2), 0.0);
+  std::vector<double> values = {3, nan, 1, 2};
+  EXPECT_EQ(FiniteMedian(values), 2.0);
 }
 
 }  // namespace
