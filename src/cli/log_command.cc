@@ -15,6 +15,93 @@
 #include "liftoff/sync/trial_analysis.h"
 
 namespace liftoff::cli {
+namespace {
+
+// The sample stream's span, rate and gaps, and the vertebra's range.
+struct LogStats {
+  int64_t gaps = 0;                // steps longer than the gap threshold
+  int64_t longest_gap_ns = 0;      // the longest step
+  int64_t longest_gap_at_ns = 0;   // the sample it follows
+  double rate_hz = 0.0;            // mean sample rate; 0 for under two instants
+  double min_angle_rad = INFINITY, max_angle_rad = -INFINITY;  // infinite without angles
+};
+
+LogStats MeasureLog(const ControllerLog& log, int64_t gap_threshold_ns) {
+  const std::vector<LogSample>& samples = log.samples;
+  LogStats stats;
+  for (size_t i = 1; i < samples.size(); ++i) {
+    const int64_t step = samples[i].device_time_ns - samples[i - 1].device_time_ns;
+    if (step > gap_threshold_ns) ++stats.gaps;
+    if (step > stats.longest_gap_ns) {
+      stats.longest_gap_ns = step;
+      stats.longest_gap_at_ns = samples[i - 1].device_time_ns;
+    }
+  }
+  const int64_t span_ns = log.LastSampleNs() - log.FirstSampleNs();
+  if (span_ns > 0) stats.rate_hz = static_cast<double>(samples.size() - 1) / SecondsFromNs(span_ns);
+  for (const LogSample& sample : samples) {
+    if (std::isnan(sample.vertebra_rad)) continue;
+    stats.min_angle_rad = std::min(stats.min_angle_rad, sample.vertebra_rad);
+    stats.max_angle_rad = std::max(stats.max_angle_rad, sample.vertebra_rad);
+  }
+  return stats;
+}
+
+nlohmann::json FiniteOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+}
+
+// The summary as `log --json` prints it.
+nlohmann::json LogJson(const LogCommand& command, const ControllerLog& log, const LogStats& stats) {
+  const std::optional<int64_t> led_ns = log.LedOnTimeNs();
+  return {
+      {"log", command.log_path.string()},
+      {"format", log.report.format},
+      {"calibration", log.header.calibration},
+      {"samples", log.samples.size()},
+      {"events", log.events.size()},
+      {"first_sample_s", SecondsFromNs(log.FirstSampleNs())},
+      {"last_sample_s", SecondsFromNs(log.LastSampleNs())},
+      {"mean_rate_hz", stats.rate_hz},
+      {"gaps", stats.gaps},
+      {"gap_threshold_s", command.gap_threshold_s},
+      {"longest_gap_s", SecondsFromNs(stats.longest_gap_ns)},
+      {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
+      {"vertebra_min_rad", FiniteOrNull(stats.min_angle_rad)},
+      {"vertebra_max_rad", FiniteOrNull(stats.max_angle_rad)},
+      {"bad_lines", log.report.bad_lines},
+      {"truncated_last_line", log.report.truncated_last_line},
+  };
+}
+
+// The summary as `log` prints it.
+void PrintLog(const LogCommand& command, const ControllerLog& log, const LogStats& stats,
+              const Calibration& calibration, std::ostream& out) {
+  const std::optional<int64_t> led_ns = log.LedOnTimeNs();
+  out << command.log_path.string() << " (" << log.report.format << ")\n"
+      << "  samples: " << log.samples.size() << ", events: " << log.events.size()
+      << ", bad lines: " << log.report.bad_lines
+      << (log.report.truncated_last_line ? " (last line truncated)" : "") << '\n'
+      << "  device time: " << FormatSeconds(log.FirstSampleNs()) << " .. "
+      << FormatSeconds(log.LastSampleNs()) << " s, mean rate " << FormatFixed(stats.rate_hz, 1)
+      << " Hz\n"
+      << "  gaps longer than " << FormatFixed(command.gap_threshold_s, 3) << " s: " << stats.gaps;
+  if (stats.longest_gap_ns > 0) {
+    out << " (longest " << FormatSeconds(stats.longest_gap_ns) << " s after "
+        << FormatSeconds(stats.longest_gap_at_ns) << " s)";
+  }
+  out << '\n'
+      << "  LED on: "
+      << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)") << '\n';
+  if (std::isfinite(stats.min_angle_rad)) {
+    out << "  vertebra angle: " << FormatFixed(stats.min_angle_rad, 4) << " .. "
+        << FormatFixed(stats.max_angle_rad, 4) << " rad (calibration " << calibration.Brief()
+        << ")\n";
+  }
+}
+
+}  // namespace
+
 // ---------------------------------------------------------------------------------------
 // liftoff log
 
@@ -39,73 +126,11 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
   if (!log.ok()) return ReportError(log.status(), err);
   PrintLogWarnings(log->report, err);
 
-  // span, rate and gaps of the sample stream
-  const std::vector<LogSample>& samples = log->samples;
-  const int64_t gap_threshold_ns = NsFromSeconds(command.gap_threshold_s);
-  int64_t gaps = 0;
-  int64_t longest_gap_ns = 0;
-  int64_t longest_gap_at_ns = 0;
-  for (size_t i = 1; i < samples.size(); ++i) {
-    const int64_t step = samples[i].device_time_ns - samples[i - 1].device_time_ns;
-    if (step > gap_threshold_ns) ++gaps;
-    if (step > longest_gap_ns) {
-      longest_gap_ns = step;
-      longest_gap_at_ns = samples[i - 1].device_time_ns;
-    }
-  }
-  const int64_t span_ns = log->LastSampleNs() - log->FirstSampleNs();
-  const double rate_hz =
-      span_ns > 0 ? static_cast<double>(samples.size() - 1) / SecondsFromNs(span_ns) : 0.0;
-  const std::optional<int64_t> led_ns = log->LedOnTimeNs();
-  double min_angle = INFINITY, max_angle = -INFINITY;
-  for (const LogSample& sample : samples) {
-    if (std::isnan(sample.vertebra_rad)) continue;
-    min_angle = std::min(min_angle, sample.vertebra_rad);
-    max_angle = std::max(max_angle, sample.vertebra_rad);
-  }
-
+  const LogStats stats = MeasureLog(*log, NsFromSeconds(command.gap_threshold_s));
   if (command.json) {
-    nlohmann::json document = {
-        {"log", command.log_path.string()},
-        {"format", log->report.format},
-        {"calibration", log->header.calibration},
-        {"samples", samples.size()},
-        {"events", log->events.size()},
-        {"first_sample_s", SecondsFromNs(log->FirstSampleNs())},
-        {"last_sample_s", SecondsFromNs(log->LastSampleNs())},
-        {"mean_rate_hz", rate_hz},
-        {"gaps", gaps},
-        {"gap_threshold_s", command.gap_threshold_s},
-        {"longest_gap_s", SecondsFromNs(longest_gap_ns)},
-        {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
-        {"vertebra_min_rad",
-         std::isfinite(min_angle) ? nlohmann::json(min_angle) : nlohmann::json()},
-        {"vertebra_max_rad",
-         std::isfinite(max_angle) ? nlohmann::json(max_angle) : nlohmann::json()},
-        {"bad_lines", log->report.bad_lines},
-        {"truncated_last_line", log->report.truncated_last_line},
-    };
-    out << document.dump(2) << '\n';
+    out << LogJson(command, *log, stats).dump(2) << '\n';
   } else {
-    out << command.log_path.string() << " (" << log->report.format << ")\n"
-        << "  samples: " << samples.size() << ", events: " << log->events.size()
-        << ", bad lines: " << log->report.bad_lines
-        << (log->report.truncated_last_line ? " (last line truncated)" : "") << '\n'
-        << "  device time: " << FormatSeconds(log->FirstSampleNs()) << " .. "
-        << FormatSeconds(log->LastSampleNs()) << " s, mean rate " << FormatFixed(rate_hz, 1)
-        << " Hz\n"
-        << "  gaps longer than " << FormatFixed(command.gap_threshold_s, 3) << " s: " << gaps;
-    if (longest_gap_ns > 0) {
-      out << " (longest " << FormatSeconds(longest_gap_ns) << " s after "
-          << FormatSeconds(longest_gap_at_ns) << " s)";
-    }
-    out << '\n'
-        << "  LED on: "
-        << (led_ns ? FormatSeconds(*led_ns) + " s" : "no LED event (origin = LED on)") << '\n';
-    if (std::isfinite(min_angle)) {
-      out << "  vertebra angle: " << FormatFixed(min_angle, 4) << " .. "
-          << FormatFixed(max_angle, 4) << " rad (calibration " << calibration->Brief() << ")\n";
-    }
+    PrintLog(command, *log, stats, *calibration, out);
   }
 
   if (!command.convert_path.empty()) {

@@ -38,6 +38,71 @@ Result<EventTimes> TimesFromFlags(const SyncCommand& command) {
   return times;
 }
 
+// Exactly one source of the video instants: the clip (with the foot's region), or both
+// instants on the command line.
+Status CheckInstantSources(const SyncCommand& command) {
+  const bool from_video = !command.video_path.empty();
+  const bool from_flags = command.led_on_s || command.liftoff_s;
+  if (from_video && (from_flags || command.uncertainty_s != 0.0)) {
+    return InvalidArgumentError("--video excludes --led-on, --liftoff and --uncertainty: the "
+                                "clip's analysis gives the instants and their uncertainties");
+  }
+  if (!from_video && !from_flags) {
+    return InvalidArgumentError("no video instants: give --led-on S --liftoff S, or --video CLIP "
+                                "--foot-roi x,y,w,h to find them");
+  }
+  if (from_video && command.clip.foot_roi.empty()) {
+    return InvalidArgumentError("--video needs --foot-roi x,y,w,h: the liftoff comes from the foot");
+  }
+  return Status::Ok();
+}
+
+// The result as `sync --json` prints it.
+nlohmann::json SyncJson(const SyncCommand& command, const Calibration& calibration,
+                        const sync::LookupOptions& lookup,
+                        const sync::LiftoffMeasurement& measured, const EventTimes& times,
+                        const std::optional<video::ClipAnalysis>& clip) {
+  const sync::AngleLookup& at = measured.lookup;
+  return {
+      {"log", command.log_path.string()},
+      {"calibration", calibration.Brief()},
+      {"rule", sync::LookupRuleName(lookup.rule)},
+      {"interval_s", SecondsFromNs(measured.interval_ns)},
+      {"interval_uncertainty_s", SecondsFromNs(measured.interval_uncertainty_ns)},
+      {"liftoff_log_s", SecondsFromNs(measured.liftoff_log_ns)},
+      {"vertebra_rad", at.vertebra_rad},
+      {"liftoff_rad", measured.liftoff_rad},
+      {"lower_rad", measured.lower_rad},
+      {"upper_rad", measured.upper_rad},
+      {"in_gap", at.in_gap},
+      {"past_end", at.past_end},
+      {"warnings", at.warnings},
+      {"times",
+       {{"source", times.source},
+        {"led_on_s", SecondsFromNs(times.led_on_ns)},
+        {"led_on_uncertainty_s", SecondsFromNs(times.led_on_uncertainty_ns)},
+        {"liftoff_s", SecondsFromNs(times.liftoff_ns)},
+        {"liftoff_uncertainty_s", SecondsFromNs(times.liftoff_uncertainty_ns)}}},
+      {"video", clip ? clip->ToJson() : nlohmann::json()},
+  };
+}
+
+// The result as `sync` prints it.
+void PrintSync(const Calibration& calibration, const sync::LookupOptions& lookup,
+               const sync::LiftoffMeasurement& measured,
+               const std::optional<video::ClipAnalysis>& clip, std::ostream& out) {
+  if (clip) out << "video: " << clip->Brief() << '\n';
+  out << "calibration: " << calibration.Brief() << "; rule: " << sync::LookupRuleName(lookup.rule)
+      << '\n'
+      << "interval LED on -> liftoff: " << FormatSeconds(measured.interval_ns, 3) << " s +- "
+      << FormatSeconds(measured.interval_uncertainty_ns, 3) << " s\n"
+      << "log instant: " << FormatSeconds(measured.liftoff_log_ns, 3) << " s\n"
+      << "vertebra angle: " << FormatFixed(measured.lookup.vertebra_rad, 4) << " rad; at liftoff |angle| "
+      << FormatFixed(measured.liftoff_rad, 4) << " rad in [" << FormatFixed(measured.lower_rad, 4)
+      << ", " << FormatFixed(measured.upper_rad, 4) << "]\n";
+  for (const std::string& warning : measured.lookup.warnings) out << "note: " << warning << '\n';
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -48,27 +113,13 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   auto lookup = LookupOptionsFrom(command.lookup);
   if (!lookup.ok()) return ReportError(lookup.status(), err);
   const bool from_video = !command.video_path.empty();
-  const bool from_flags = command.led_on_s || command.liftoff_s;
-  if (from_video && (from_flags || command.uncertainty_s != 0.0)) {
-    return ReportError(InvalidArgumentError("--video excludes --led-on, --liftoff and "
-                                            "--uncertainty: the clip's analysis gives the instants "
-                                            "and their uncertainties"),
-                       err);
-  }
-  if (!from_video && !from_flags) {
-    return ReportError(InvalidArgumentError("no video instants: give --led-on S --liftoff S, or "
-                                            "--video CLIP --foot-roi x,y,w,h to find them"),
-                       err);
+  if (const Status sources = CheckInstantSources(command); !sources.ok()) {
+    return ReportError(sources, err);
   }
   EventTimes times;
   std::optional<video::ClipAnalysisOptions> clip_options;
   std::optional<VideoProgress> progress;
   if (from_video) {
-    if (command.clip.foot_roi.empty()) {
-      return ReportError(
-          InvalidArgumentError("--video needs --foot-roi x,y,w,h: the liftoff comes from the foot"),
-          err);
-    }
     auto options = ClipOptionsFrom(command.clip);
     if (!options.ok()) return ReportError(options.status(), err);
     clip_options = std::move(options).value();
@@ -121,43 +172,11 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
     return ReportError(measured.status().WithContext(command.log_path.filename().string()), err);
   }
 
-  const sync::AngleLookup& at = measured->lookup;
   if (command.json) {
-    nlohmann::json document = {
-        {"log", command.log_path.string()},
-        {"calibration", calibration->Brief()},
-        {"rule", sync::LookupRuleName(lookup->rule)},
-        {"interval_s", SecondsFromNs(measured->interval_ns)},
-        {"interval_uncertainty_s", SecondsFromNs(measured->interval_uncertainty_ns)},
-        {"liftoff_log_s", SecondsFromNs(measured->liftoff_log_ns)},
-        {"vertebra_rad", at.vertebra_rad},
-        {"liftoff_rad", measured->liftoff_rad},
-        {"lower_rad", measured->lower_rad},
-        {"upper_rad", measured->upper_rad},
-        {"in_gap", at.in_gap},
-        {"past_end", at.past_end},
-        {"warnings", at.warnings},
-        {"times",
-         {{"source", times.source},
-          {"led_on_s", SecondsFromNs(times.led_on_ns)},
-          {"led_on_uncertainty_s", SecondsFromNs(times.led_on_uncertainty_ns)},
-          {"liftoff_s", SecondsFromNs(times.liftoff_ns)},
-          {"liftoff_uncertainty_s", SecondsFromNs(times.liftoff_uncertainty_ns)}}},
-        {"video", clip ? clip->ToJson() : nlohmann::json()},
-    };
-    out << document.dump(2) << '\n';
+    out << SyncJson(command, *calibration, *lookup, *measured, times, clip).dump(2) << '\n';
     return kExitOk;
   }
-  if (clip) out << "video: " << clip->Brief() << '\n';
-  out << "calibration: " << calibration->Brief() << "; rule: " << sync::LookupRuleName(lookup->rule)
-      << '\n'
-      << "interval LED on -> liftoff: " << FormatSeconds(measured->interval_ns, 3) << " s +- "
-      << FormatSeconds(measured->interval_uncertainty_ns, 3) << " s\n"
-      << "log instant: " << FormatSeconds(measured->liftoff_log_ns, 3) << " s\n"
-      << "vertebra angle: " << FormatFixed(at.vertebra_rad, 4) << " rad; at liftoff |angle| "
-      << FormatFixed(measured->liftoff_rad, 4) << " rad in [" << FormatFixed(measured->lower_rad, 4)
-      << ", " << FormatFixed(measured->upper_rad, 4) << "]\n";
-  for (const std::string& warning : at.warnings) out << "note: " << warning << '\n';
+  PrintSync(*calibration, *lookup, *measured, clip, out);
   return kExitOk;
 }
 

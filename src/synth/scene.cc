@@ -426,6 +426,70 @@ float DiscCoverage(double x, double y, double cx, double cy, double radius) {
   return static_cast<float>(inside) / (kSub * kSub);
 }
 
+// Where the feet stand (near, right feet C and A; far, left feet D and B): their shapes on
+// the canvas and their placements in the image.
+std::array<FootShape, 4> PlaceFeet(const Camera& camera,
+                                   std::array<SceneRenderer::FootPlacement, 4>& placements) {
+  const int margin = kMarginPx;
+  const double near_m = kCameraDistanceM - kFeetHalfWidthM;
+  const double far_m = kCameraDistanceM + kFeetHalfWidthM;
+  std::array<FootShape, 4> shapes;
+  for (Foot foot : kAllFeet) {
+    const bool front = foot == Foot::kA || foot == Foot::kB;
+    const bool near = foot == Foot::kA || foot == Foot::kC;
+    const double depth_m = near ? near_m : far_m;
+    const cv::Point2d contact =
+        camera.Project(front ? kFeetHalfLengthM : -kFeetHalfLengthM, 0, depth_m);
+    FootShape& shape = shapes[static_cast<size_t>(foot)];
+    shape.center_x = contact.x + margin;
+    shape.bottom = std::floor(contact.y) + 0.5 + margin;  // on a pixel boundary
+    shape.px_per_mm = camera.focal_px / camera.AxisDepth(depth_m) / 1000;
+    shape.tape = TapeBgr(foot);
+    SceneRenderer::FootPlacement& place = placements[static_cast<size_t>(foot)];
+    place.center_x_px = shape.center_x - margin;
+    place.bottom_px = shape.bottom - margin;
+    place.px_per_mm = shape.px_per_mm;
+    place.width_px = kFootWidthMm * shape.px_per_mm;
+    place.height_px = kFootHeightMm * shape.px_per_mm;
+    place.tape_top_px = place.bottom_px - kTapeHighMm * shape.px_per_mm;
+    place.tape_bottom_px = place.bottom_px - kTapeLowMm * shape.px_per_mm;
+  }
+  return shapes;
+}
+
+// The LED's board and its dark disc, on the wall: centre (led_x, led_y) and radius in
+// canvas px.
+void DrawLedBoard(double led_x, double led_y, double radius, cv::Mat& base) {
+  const double board_half = std::max(3.2 * radius, radius + 8);
+  const cv::Rect box =
+      cv::Rect(static_cast<int>(std::floor(led_x - board_half - 2)),
+               static_cast<int>(std::floor(led_y - board_half - 2)),
+               static_cast<int>(2 * board_half + 5), static_cast<int>(2 * board_half + 5)) &
+      cv::Rect(0, 0, base.cols, base.rows);
+  for (int row = box.y; row < box.y + box.height; ++row) {
+    for (int col = box.x; col < box.x + box.width; ++col) {
+      // board coverage: a square, 4 x 4 samples
+      int inside = 0;
+      for (int s = 0; s < 16; ++s) {
+        const double x = col - 0.5 + (s % 4 + 0.5) / 4, y = row - 0.5 + (s / 4 + 0.5) / 4;
+        inside += std::abs(x - led_x) <= board_half && std::abs(y - led_y) <= board_half;
+      }
+      const float board = static_cast<float>(inside) / 16;
+      const float bezel = DiscCoverage(col, row, led_x, led_y, radius * 1.35);
+      const float disc = DiscCoverage(col, row, led_x, led_y, radius);
+      const double dist = std::hypot(col - led_x + 0.3 * radius, row - led_y + 0.3 * radius);
+      const double highlight = 40 * std::exp(-dist * dist / (0.1 * radius * radius + 0.5));
+      cv::Vec3f& pixel = base.at<cv::Vec3f>(row, col);
+      pixel = pixel * (1 - board) + cv::Vec3f(30, 34, 30) * board;
+      pixel = pixel * (1 - bezel) + cv::Vec3f(52, 52, 55) * bezel;
+      pixel = pixel * (1 - disc) + cv::Vec3f(static_cast<float>(74 + highlight),
+                                             static_cast<float>(76 + highlight),
+                                             static_cast<float>(80 + highlight)) *
+                                       disc;
+    }
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -450,100 +514,20 @@ void SceneRenderer::Build(const Timeline& timeline) {
   exposure_ns_ = ExposureNs(spec.camera);
   const int margin = kMarginPx;
   const Camera camera = MakeCamera(width_px_, height_px_);
-  const uint64_t salt = SeedFor(spec.seed, kTextureStream);
-
-  // where the feet stand: near (right) feet C and A, far (left) feet D and B
-  const double near_m = kCameraDistanceM - kFeetHalfWidthM;
-  const double far_m = kCameraDistanceM + kFeetHalfWidthM;
-  std::array<FootShape, 4> shapes;
-  for (Foot foot : kAllFeet) {
-    const bool front = foot == Foot::kA || foot == Foot::kB;
-    const bool near = foot == Foot::kA || foot == Foot::kC;
-    const double depth_m = near ? near_m : far_m;
-    const cv::Point2d contact =
-        camera.Project(front ? kFeetHalfLengthM : -kFeetHalfLengthM, 0, depth_m);
-    FootShape& shape = shapes[static_cast<size_t>(foot)];
-    shape.center_x = contact.x + margin;
-    shape.bottom = std::floor(contact.y) + 0.5 + margin;  // on a pixel boundary
-    shape.px_per_mm = camera.focal_px / camera.AxisDepth(depth_m) / 1000;
-    shape.tape = TapeBgr(foot);
-    FootPlacement& place = placements_[static_cast<size_t>(foot)];
-    place.center_x_px = shape.center_x - margin;
-    place.bottom_px = shape.bottom - margin;
-    place.px_per_mm = shape.px_per_mm;
-    place.width_px = kFootWidthMm * shape.px_per_mm;
-    place.height_px = kFootHeightMm * shape.px_per_mm;
-    place.tape_top_px = place.bottom_px - kTapeHighMm * shape.px_per_mm;
-    place.tape_bottom_px = place.bottom_px - kTapeLowMm * shape.px_per_mm;
-  }
+  const std::array<FootShape, 4> shapes = PlaceFeet(camera, placements_);
 
   // the bed and the wall, the tape ruler 6 cm in front of the near feet
   cv::Mat base(height_px_ + 2 * margin, width_px_ + 2 * margin, CV_32FC3);
-  RenderBackground(camera, margin, salt, near_m - 0.085, base);
-
-  // the LED's board and its dark disc, on the wall
+  RenderBackground(camera, margin, SeedFor(spec.seed, kTextureStream),
+                   kCameraDistanceM - kFeetHalfWidthM - 0.085, base);
+  // the LED: its board, then its light, drawn per frame over led_patch_
   const LedSpec& led = spec.led;
   const double led_x = led.x_frac * width_px_ - 0.5 + margin;
   const double led_y = led.y_frac * height_px_ - 0.5 + margin;
-  const double radius = led.radius_px;
-  {
-    const double board_half = std::max(3.2 * radius, radius + 8);
-    const cv::Rect box =
-        cv::Rect(static_cast<int>(std::floor(led_x - board_half - 2)),
-                 static_cast<int>(std::floor(led_y - board_half - 2)),
-                 static_cast<int>(2 * board_half + 5), static_cast<int>(2 * board_half + 5)) &
-        cv::Rect(0, 0, base.cols, base.rows);
-    for (int row = box.y; row < box.y + box.height; ++row) {
-      for (int col = box.x; col < box.x + box.width; ++col) {
-        // board coverage: a square, 4 x 4 samples
-        int inside = 0;
-        for (int s = 0; s < 16; ++s) {
-          const double x = col - 0.5 + (s % 4 + 0.5) / 4, y = row - 0.5 + (s / 4 + 0.5) / 4;
-          inside += std::abs(x - led_x) <= board_half && std::abs(y - led_y) <= board_half;
-        }
-        const float board = static_cast<float>(inside) / 16;
-        const float bezel = DiscCoverage(col, row, led_x, led_y, radius * 1.35);
-        const float disc = DiscCoverage(col, row, led_x, led_y, radius);
-        const double dist = std::hypot(col - led_x + 0.3 * radius, row - led_y + 0.3 * radius);
-        const double highlight = 40 * std::exp(-dist * dist / (0.1 * radius * radius + 0.5));
-        cv::Vec3f& pixel = base.at<cv::Vec3f>(row, col);
-        pixel = pixel * (1 - board) + cv::Vec3f(30, 34, 30) * board;
-        pixel = pixel * (1 - bezel) + cv::Vec3f(52, 52, 55) * bezel;
-        pixel = pixel * (1 - disc) + cv::Vec3f(static_cast<float>(74 + highlight),
-                                               static_cast<float>(76 + highlight),
-                                               static_cast<float>(80 + highlight)) *
-                                         disc;
-      }
-    }
-  }
+  DrawLedBoard(led_x, led_y, led.radius_px, base);
   ApplyVignette(base, margin, camera);
-
-  // the LED's light: disc and bloom, drawn per frame over led_patch_
-  const double bloom_sigma = 0.5 * led.bloom * radius;
-  const int patch_half = static_cast<int>(std::ceil(radius + 3 * bloom_sigma + 2));
-  led_patch_ = cv::Rect(static_cast<int>(std::floor(led_x)) - patch_half,
-                        static_cast<int>(std::floor(led_y)) - patch_half, 2 * patch_half + 2,
-                        2 * patch_half + 2) &
-               cv::Rect(0, 0, base.cols, base.rows);
-  led_disc_alpha_ = cv::Mat(led_patch_.size(), CV_32FC1);
-  led_emission_ = cv::Mat(led_patch_.size(), CV_32FC3);
-  const cv::Vec3d led_bgr(led.blue, led.green, led.red);
-  const double white_core = 180 * std::max(0.0, led.intensity - 1);
-  for (int row = 0; row < led_patch_.height; ++row) {
-    for (int col = 0; col < led_patch_.width; ++col) {
-      const double x = led_patch_.x + col, y = led_patch_.y + row;
-      const float disc = DiscCoverage(x, y, led_x, led_y, radius);
-      const double dist2 = (x - led_x) * (x - led_x) + (y - led_y) * (y - led_y);
-      const double halo =
-          led.bloom > 0 ? 0.8 * std::exp(-dist2 / (2 * bloom_sigma * bloom_sigma)) : 0;
-      const cv::Vec3d emission =
-          static_cast<double>(disc) * (led.intensity * led_bgr + cv::Vec3d::all(white_core)) +
-          halo * led.intensity * led_bgr;
-      led_disc_alpha_.at<float>(row, col) = disc;
-      led_emission_.at<cv::Vec3f>(row, col) = cv::Vec3f(emission);
-    }
-  }
-  const double led_roi_half = radius + kShakeBoundPx + 2;
+  BuildLedLight(led, led_x, led_y);
+  const double led_roi_half = led.radius_px + kShakeBoundPx + 2;
   led_roi_px_ = ClippedRegion(led_x - margin - led_roi_half, led_y - margin - led_roi_half,
                               led_x - margin + led_roi_half, led_y - margin + led_roi_half);
 
@@ -585,13 +569,8 @@ void SceneRenderer::Build(const Timeline& timeline) {
       DrawSprite(colour, alpha, region, base);
       continue;
     }
-    MovingFoot moving;
-    moving.foot = foot;
-    moving.region = region;
-    moving.sprite_colour = std::move(colour);
-    moving.sprite_alpha = std::move(alpha);
-    moving.first_varying_row = first_varying_row;
-    moving_.push_back(std::move(moving));
+    moving_.push_back(MovingFoot{foot, region, cv::Mat(), std::move(colour), std::move(alpha),
+                                 first_varying_row});
   }
   for (MovingFoot& moving : moving_) base(moving.region).copyTo(moving.background);
 
@@ -601,26 +580,57 @@ void SceneRenderer::Build(const Timeline& timeline) {
     ComposeMovingFoot(moving, std::vector<double>{0.0}, true, static_canvas_);
   }
 
-  // the noise table: Gaussian grey levels, split into positive and negative parts
-  if (spec.nuisance.noise_sigma > 0) {
-    const size_t count =
-        static_cast<size_t>(width_px_) * static_cast<size_t>(height_px_) * 3 + kNoiseOffsets;
-    noise_positive_.assign(count, 0);
-    noise_negative_.assign(count, 0);
-    SplitMix64 rng(SeedFor(spec.seed, kNoiseTableStream));
-    for (size_t i = 0; i < count; i += 2) {
-      const double u1 = 1.0 - rng.Uniform(), u2 = rng.Uniform();
-      const double r = std::sqrt(-2.0 * std::log(u1)) * spec.nuisance.noise_sigma;
-      const std::array<double, 2> values = {r * std::cos(2 * kPi * u2), r * std::sin(2 * kPi * u2)};
-      for (size_t k = 0; k < 2 && i + k < count; ++k) {
-        const long level = std::clamp(std::lround(values[k]), -255L, 255L);
-        noise_positive_[i + k] = static_cast<uint8_t>(std::max(0L, level));
-        noise_negative_[i + k] = static_cast<uint8_t>(std::max(0L, -level));
-      }
-    }
-  }
+  BuildNoiseTable(spec);
   shake_rng_ = SplitMix64(SeedFor(spec.seed, kShakeStream));
   shake_px_.assign(1, cv::Point2d(0, 0));
+}
+
+void SceneRenderer::BuildLedLight(const LedSpec& led, double led_x, double led_y) {
+  const double radius = led.radius_px;
+  const double bloom_sigma = 0.5 * led.bloom * radius;
+  const int patch_half = static_cast<int>(std::ceil(radius + 3 * bloom_sigma + 2));
+  led_patch_ = cv::Rect(static_cast<int>(std::floor(led_x)) - patch_half,
+                        static_cast<int>(std::floor(led_y)) - patch_half, 2 * patch_half + 2,
+                        2 * patch_half + 2) &
+               cv::Rect(0, 0, width_px_ + 2 * kMarginPx, height_px_ + 2 * kMarginPx);
+  led_disc_alpha_ = cv::Mat(led_patch_.size(), CV_32FC1);
+  led_emission_ = cv::Mat(led_patch_.size(), CV_32FC3);
+  const cv::Vec3d led_bgr(led.blue, led.green, led.red);
+  const double white_core = 180 * std::max(0.0, led.intensity - 1);
+  for (int row = 0; row < led_patch_.height; ++row) {
+    for (int col = 0; col < led_patch_.width; ++col) {
+      const double x = led_patch_.x + col, y = led_patch_.y + row;
+      const float disc = DiscCoverage(x, y, led_x, led_y, radius);
+      const double dist2 = (x - led_x) * (x - led_x) + (y - led_y) * (y - led_y);
+      const double halo =
+          led.bloom > 0 ? 0.8 * std::exp(-dist2 / (2 * bloom_sigma * bloom_sigma)) : 0;
+      const cv::Vec3d emission =
+          static_cast<double>(disc) * (led.intensity * led_bgr + cv::Vec3d::all(white_core)) +
+          halo * led.intensity * led_bgr;
+      led_disc_alpha_.at<float>(row, col) = disc;
+      led_emission_.at<cv::Vec3f>(row, col) = cv::Vec3f(emission);
+    }
+  }
+}
+
+void SceneRenderer::BuildNoiseTable(const TrialSpec& spec) {
+  // Gaussian grey levels, split into positive and negative parts
+  if (spec.nuisance.noise_sigma <= 0) return;
+  const size_t count =
+      static_cast<size_t>(width_px_) * static_cast<size_t>(height_px_) * 3 + kNoiseOffsets;
+  noise_positive_.assign(count, 0);
+  noise_negative_.assign(count, 0);
+  SplitMix64 rng(SeedFor(spec.seed, kNoiseTableStream));
+  for (size_t i = 0; i < count; i += 2) {
+    const double u1 = 1.0 - rng.Uniform(), u2 = rng.Uniform();
+    const double r = std::sqrt(-2.0 * std::log(u1)) * spec.nuisance.noise_sigma;
+    const std::array<double, 2> values = {r * std::cos(2 * kPi * u2), r * std::sin(2 * kPi * u2)};
+    for (size_t k = 0; k < 2 && i + k < count; ++k) {
+      const long level = std::clamp(std::lround(values[k]), -255L, 255L);
+      noise_positive_[i + k] = static_cast<uint8_t>(std::max(0L, level));
+      noise_negative_[i + k] = static_cast<uint8_t>(std::max(0L, -level));
+    }
+  }
 }
 
 RegionPx SceneRenderer::ClippedRegion(double x0, double y0, double x1, double y1) const {

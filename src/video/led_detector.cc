@@ -419,6 +419,9 @@ struct LedDetector::Impl {
   // clipped). False when the step does not look like a light: pixels stepping the other
   // way by a good part of it (an edge moved by camera shake or a passing part).
   bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event);
+  // Each ROI pixel's step at frame k (pixel_steps, channel_steps, lit_peaks, pixel_wobble;
+  // its gain-corrected series in `corrected`); the sums of the pixels' off and on levels.
+  void MeasurePixelSteps(int64_t k, bool rise, double& off_sum, double& on_sum);
   // the quantile q of |pixel_steps| over the ROI's inner pixels
   double InnerQuantile(double q);
 
@@ -486,6 +489,8 @@ struct LedDetector::Impl {
   static int ChooseRegion(const std::vector<const StepEvent*>& steps);
 
   Result<LedResult> Finish() const;
+  // Why no step of `steps` (in the order they happened) is a switch-on seen `where`.
+  Status NoSwitchOn(const std::vector<const StepEvent*>& steps, const std::string& where) const;
 };
 
 cv::Rect LedDetector::Impl::RegionRect(int region) const {
@@ -761,13 +766,13 @@ bool LedDetector::Impl::SmallLightInRenewedBlock(double largest, size_t width) c
   return small && opposite_strong <= kRoiOppositeFrac * stepped_strong;
 }
 
-bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
+void LedDetector::Impl::MeasurePixelSteps(int64_t k, bool rise, double& off_sum, double& on_sum) {
   const size_t pixels = pixel_reference.size();
   const auto frames_in_ring = static_cast<size_t>(ring);
   const auto before = static_cast<size_t>(kBeforeFrames);
   const auto width = static_cast<size_t>(options.roi_px.width);
   std::vector<float> peaks(frames_in_ring);
-  double off_sum = 0.0, on_sum = 0.0;
+  off_sum = on_sum = 0.0;
   for (size_t i = 0; i < pixels; ++i) {
     float* values = &corrected[i * frames_in_ring];
     for (size_t j = 0; j < frames_in_ring; ++j) {
@@ -792,6 +797,14 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
     off_sum += rise ? level_before : level_after;
     on_sum += rise ? level_after : level_before;
   }
+}
+
+bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
+  const size_t pixels = pixel_reference.size();
+  const auto frames_in_ring = static_cast<size_t>(ring);
+  const auto width = static_cast<size_t>(options.roi_px.width);
+  double off_sum = 0.0, on_sum = 0.0;
+  MeasurePixelSteps(k, rise, off_sum, on_sum);
   // a pixel's noise (the median frame-to-frame change is 0.95 sigma for Gaussian noise)
   const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
   const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
@@ -1256,6 +1269,27 @@ int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) 
   return best;
 }
 
+Status LedDetector::Impl::NoSwitchOn(const std::vector<const StepEvent*>& steps,
+                                     const std::string& where) const {
+  for (const StepEvent* step : steps) {
+    const StepEvent& event = *step;
+    if (!event.rise) {
+      return NotFoundError("the LED never switches on: the only light step " + where +
+                           " goes off, at " +
+                           FormatFixed(SecondsFromNs(*DatePulse(event).off_ns), 4) +
+                           " s (was the LED already on at the start?)");
+    }
+  }
+  std::string message = "the LED never switches on: no brightness step " + where +
+                        " rises and holds for " + Plural(options.min_on_frames, "frame");
+  if (rejected_region >= 0) {
+    message += " with enough contrast (the best: " + FormatFixed(rejected_contrast, 0) +
+               " grey levels at " + RectText(RegionRect(rejected_region)) +
+               ", min_contrast_levels " + FormatFixed(options.min_contrast_levels, 0) + ")";
+  }
+  return NotFoundError(message);
+}
+
 Result<LedResult> LedDetector::Impl::Finish() const {
   LIFTOFF_RETURN_IF_ERROR(options_status);
   if (frames == 0) return InvalidArgumentError("LED detector: no frame was given");
@@ -1269,25 +1303,7 @@ Result<LedResult> LedDetector::Impl::Finish() const {
     return a->index[kBeforeFrames] < b->index[kBeforeFrames];
   });
   const int best = ChooseRegion(steps);
-  if (best < 0) {
-    for (const StepEvent* step : steps) {
-      const StepEvent& event = *step;
-      if (!event.rise) {
-        return NotFoundError("the LED never switches on: the only light step " + where +
-                             " goes off, at " +
-                             FormatFixed(SecondsFromNs(*DatePulse(event).off_ns), 4) +
-                             " s (was the LED already on at the start?)");
-      }
-    }
-    std::string message = "the LED never switches on: no brightness step " + where +
-                          " rises and holds for " + Plural(options.min_on_frames, "frame");
-    if (rejected_region >= 0) {
-      message += " with enough contrast (the best: " + FormatFixed(rejected_contrast, 0) +
-                 " grey levels at " + RectText(RegionRect(rejected_region)) +
-                 ", min_contrast_levels " + FormatFixed(options.min_contrast_levels, 0) + ")";
-    }
-    return NotFoundError(message);
-  }
+  if (best < 0) return NoSwitchOn(steps, where);
 
   // the LED's own steps: every pulse of one LED has about the same contrast, so the
   // region's fainter steps are something else (a shadow, a shifted edge)

@@ -119,6 +119,11 @@ class SceneRenderer {
   SceneRenderer() = default;
   void Build(const Timeline& timeline);  // throws cv::Exception
   RegionPx ClippedRegion(double x0_px, double y0_px, double x1_px, double y1_px) const;
+  // The LED's light (disc and bloom, per unit of its on-fraction) around its centre at
+  // (led_x, led_y) canvas px: led_patch_, led_disc_alpha_, led_emission_.
+  void BuildLedLight(const LedSpec& led, double led_x, double led_y);
+  // The noise table (noise_positive_, noise_negative_); empty without noise.
+  void BuildNoiseTable(const TrialSpec& spec);
 
   // A foot that moves: its sprite (premultiplied BGR and coverage, rows from canvas row
   // 0) and the scene behind it, over the region it can touch (canvas px, from row 0).
