@@ -1080,22 +1080,27 @@ std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
 // A foot does not sink into the ground: a curve that goes below the rest level by more than
 // kSunkThresholds thresholds before its rise measures more than the foot (a leg tilting
 // as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
-// known to lie between the curve's last frame within a threshold of rest and the crossing:
-// the uncertainty reaches back to it. Returns why, or "" when the curve did not sink.
+// known to lie between the curve's last frame within a threshold of rest and the crossing
+// (a curve held down crosses late, never early): the instant moves to their middle, the
+// uncertainty covers both. Returns why, or "" when the curve did not sink.
 std::string CheckSinking(const std::vector<HeightSample>& samples,
                          const std::vector<double>& height, const LiftoffSearch& search,
-                         const FootTrack& track, double crossing_s, double& uncertainty_s) {
+                         const FootTrack& track, double& crossing_s, double& uncertainty_s) {
   size_t at = search.fit_first;
   while (at < search.fit_last && Seconds(samples[at].t_ns) < crossing_s) ++at;
   const double level = track.rest_rise_px, threshold = track.threshold_px;  // the rest window's
   const internal::Sinking sank = internal::SankBefore(samples, height, search.fit_first, at, level,
                                                       threshold, kSunkThresholds * threshold);
   if (!sank.sank) return "";
-  uncertainty_s = std::max(uncertainty_s, crossing_s - sank.rest_s);
+  const double found_s = crossing_s;
+  const internal::Instant between = internal::SunkCrossing(sank.rest_s, found_s, uncertainty_s);
+  crossing_s = between.t_s;
+  uncertainty_s = between.uncertainty_s;
   return "the height curve sank " + FormatFixed(sank.depth_px / threshold, 1) +
          " thresholds below rest before its rise (a tilting leg or a shadow among the foot's "
          "patches): the liftoff lies between " +
-         FormatFixed(sank.rest_s, 3) + " s and the crossing";
+         FormatFixed(sank.rest_s, 3) + " s and the crossing at " + FormatFixed(found_s, 3) +
+         " s";
 }
 
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from

@@ -157,4 +157,9 @@ CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,
   return check;
 }
 
+Instant SunkCrossing(double rest_s, double crossing_s, double uncertainty_s) {
+  const double middle_s = 0.5 * (rest_s + crossing_s);
+  return {middle_s, std::max(uncertainty_s, crossing_s - middle_s)};
+}
+
 }  // namespace liftoff::video::internal

@@ -79,6 +79,15 @@ Sinking SankBefore(const std::vector<HeightSample>& samples, const std::vector<d
                    size_t first, size_t at, double rest_level, double threshold_px,
                    double sunk_px);
 
+/// The liftoff of a curve that sank: it lies between the last rest frame before the sinking
+/// (rest_s) and the crossing found (a curve held down crosses late, never early). Returns
+/// the middle of the two and a half-width covering both, at least `uncertainty_s`.
+struct Instant {
+  double t_s = 0.0;
+  double uncertainty_s = 0.0;
+};
+Instant SunkCrossing(double rest_s, double crossing_s, double uncertainty_s);
+
 /// The model's crossing of `level` checked against the curve over frames [first, last].
 struct CurveCheck {
   bool disagreed = false;

@@ -134,6 +134,16 @@ TEST(SankBefore, ACurveBelowRestBeforeItsRiseIsNotTheFootAlone) {
   EXPECT_FALSE(SankBefore(samples, height, 0, 10, 0.0, 0.5, 1.0).sank);
 }
 
+TEST(SunkCrossing, TheMiddleOfTheLastRestAndTheCrossingCoveringBoth) {
+  // re-drawn hard3d-06 (--seed 2000): rest to 18.467 s, then sinking; crossing at 19.042 s
+  const Instant between = SunkCrossing(18.467, 19.042, 0.1);
+  EXPECT_NEAR(between.t_s, 18.7545, 1e-9);
+  EXPECT_NEAR(between.uncertainty_s, 0.2875, 1e-9);
+  EXPECT_NEAR(between.t_s - between.uncertainty_s, 18.467, 1e-9);
+  // a wider uncertainty from the other terms stays
+  EXPECT_EQ(SunkCrossing(18.467, 19.042, 0.4).uncertainty_s, 0.4);
+}
+
 TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<double> curve = {1, 1, 5, 1, 2, 2, nan, 9, 2};
