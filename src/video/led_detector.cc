@@ -1179,9 +1179,12 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
   const auto fraction = [&](size_t i) { return (event.value[i] - event.off) / scale; };
   // what the partly lit frame saw: its fraction within the noise band; when the LED's
   // pixels clip, a partly lit frame looks brighter than it was, so only the upper bound
-  // holds
+  // holds; so too for a dim step (a lossy codec copies or drops a step of a few grey
+  // levels whole: a half-lit frame of hard3d-06's 0.6 px LED, 9 levels, is as lit as the
+  // next)
+  const bool only_upper = event.clipped || event.contrast_levels < options.dim_warning_levels;
   const auto lit_band = [&](double f) {
-    return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - band - event.creep),
+    return LitFraction{only_upper ? 0.0 : std::max(0.0, f - band - event.creep),
                        std::min(1.0, f + band)};
   };
   const LitFraction dark{0.0, lit_above};
