@@ -242,6 +242,8 @@ struct FootTracker::Impl {
   void MakeGroundTemplates();
   cv::Point2d GroundShift();
   cv::Rect2d PlacePatches(const PatchSelection& selection, FootTrack& track) const;
+  Result<FootTrack> Measure(const PatchSelection& selection, const std::vector<size_t>& rest,
+                            std::vector<HeightSample> curve) const;
 };
 
 namespace {
@@ -606,11 +608,33 @@ struct PatchSelection {
   std::vector<double> quality;    // per frame: fraction of the foot's patches measured
 };
 
+// Patches still over frames [first, until]: measured in at least half of them, and within
+// kGroundTolerancePx of their rest level in every one (the ground template took the
+// camera's shake out).
+template <typename Value>
+std::vector<size_t> StillPatches(const RiseTable& table, size_t first, size_t until,
+                                 const Value& from_rest) {
+  std::vector<size_t> still;
+  for (size_t p = 0; p < table.patches(); ++p) {
+    size_t measured = 0;
+    bool moved = false;
+    for (size_t f = first; f <= until && !moved; ++f) {
+      const double v = from_rest(f, p);
+      if (!std::isfinite(v)) continue;
+      ++measured;
+      moved = std::abs(v) > kGroundTolerancePx;
+    }
+    if (!moved && 2 * measured > until - first + 1) still.push_back(p);
+  }
+  return still;
+}
+
 // Rest levels, the ground (patches that end where they began: their median is the shake),
 // the foot (patches of the region that end highest, less those that do not move with
 // the others) and its height: the median of the foot's patches less the shake.
 PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPatch>& patches,
-                             const std::vector<size_t>& rest, size_t frames, size_t final_count) {
+                             const std::vector<size_t>& rest, size_t frames, size_t final_count,
+                             size_t still_until) {
   PatchSelection selection;
   const size_t first = rest.front();
   std::vector<double> rest_level(table.patches(), kNaNd);
@@ -627,14 +651,19 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   }
   const auto finite_or_zero = [](double v) { return std::isfinite(v) ? v : 0.0; };
 
-  // ground and shake: a first shake from the margin, then the patches that end at rest
-  const std::vector<double> margin_shake = MedianCurve(frames, margin, 1, from_rest);
-  for (size_t p = 0; p < table.patches(); ++p) {
-    if (!std::isfinite(rest_level[p])) continue;
-    const double final_rise = FinalLevel(first, frames, final_count, [&](size_t f) {
-      return from_rest(f, p) - finite_or_zero(margin_shake[f]);
-    });
-    if (std::abs(final_rise) <= kGroundTolerancePx) selection.ground.push_back(p);
+  // ground and shake: a first shake from the margin, then the patches that end at rest;
+  // or, when asked, the patches still all along up to frame still_until
+  if (still_until > first) {
+    selection.ground = StillPatches(table, first, still_until, from_rest);
+  } else {
+    const std::vector<double> margin_shake = MedianCurve(frames, margin, 1, from_rest);
+    for (size_t p = 0; p < table.patches(); ++p) {
+      if (!std::isfinite(rest_level[p])) continue;
+      const double final_rise = FinalLevel(first, frames, final_count, [&](size_t f) {
+        return from_rest(f, p) - finite_or_zero(margin_shake[f]);
+      });
+      if (std::abs(final_rise) <= kGroundTolerancePx) selection.ground.push_back(p);
+    }
   }
   selection.shake_px = MedianCurve(frames, selection.ground, 1, from_rest);
   for (double& v : selection.shake_px) v = finite_or_zero(v);
@@ -1103,6 +1132,13 @@ std::string CheckSinking(const std::vector<HeightSample>& samples,
          " s";
 }
 
+// The first sample at or after t_ns (the last one when none is).
+size_t FrameAtOrAfter(const std::vector<HeightSample>& samples, int64_t t_ns) {
+  const auto at = std::lower_bound(samples.begin(), samples.end(), t_ns,
+                                   [](const HeightSample& s, int64_t t) { return s.t_ns < t; });
+  return at == samples.end() ? samples.size() - 1 : static_cast<size_t>(at - samples.begin());
+}
+
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
 // the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
 // a drift that comes with the rise is a shadow or a part of the robot among the ground
@@ -1179,8 +1215,32 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
   }
   // where patches end: their last 0.5 s
   const size_t final_count = std::max<size_t>(kSustainFrames, FramesIn(samples, kFinalS));
-  const PatchSelection selection = SelectPatches(table, s.patches, rest, frames, final_count);
+  const PatchSelection selection = SelectPatches(table, s.patches, rest, frames, final_count, 0);
+  Result<FootTrack> track = s.Measure(selection, rest, samples);
+  if (!track.ok()) return track;
+  // a ground that rose with the foot was the robot (a small robot filling the region's
+  // margin, tipping as the foot lifts): measured again against the patches still up to
+  // the crossing, kept when their ground moved less
+  const double drift_px = GroundDriftPx(samples, selection.shake_px, rest,
+                                        Seconds(track->above_threshold.t_ns));
+  if (drift_px <= track->threshold_px) return track;
+  const size_t until = FrameAtOrAfter(samples, track->above_threshold.t_ns);
+  const PatchSelection still =
+      SelectPatches(table, s.patches, rest, frames, final_count, until);
+  if (still.ground.size() < kFewGroundPatches) return track;
+  Result<FootTrack> again = s.Measure(still, rest, samples);
+  if (!again.ok()) return track;
+  const double again_drift_px =
+      GroundDriftPx(samples, still.shake_px, rest, Seconds(again->above_threshold.t_ns));
+  return again_drift_px < drift_px ? again : track;
+}
 
+// The foot's track from a selection of patches: its place and scale, its samples, the
+// liftoff.
+Result<FootTrack> FootTracker::Impl::Measure(const PatchSelection& selection,
+                                             const std::vector<size_t>& rest,
+                                             std::vector<HeightSample> curve) const {
+  const Options& o = options;
   FootTrack track;
   track.foot_roi_px = o.foot_roi_px;
   track.exposure_offset_ns = 0;  // a frame's time is the middle of its exposure
@@ -1188,28 +1248,28 @@ Result<FootTrack> FootTracker::FinishWith(std::vector<HeightSample> samples) con
     return NotFoundError("the foot never lifts: nothing in the foot region " +
                          RectText(o.foot_roi_px) + " rises against the ground around it");
   }
-  const cv::Rect2d foot_box = s.PlacePatches(selection, track);
+  const cv::Rect2d foot_box = PlacePatches(selection, track);
   track.foot_center_x_px = foot_box.x + (foot_box.width - 1) / 2.0;
   track.foot_width_px = foot_box.width;
   track.foot_bottom_px = foot_box.y + foot_box.height - 0.5;
   SetScale(o, foot_box.width, track);
-  FillSamples(selection, rest, o.min_quality, samples, track);
+  FillSamples(selection, rest, o.min_quality, curve, track);
 
-  const LiftoffSearch search = FindLiftoff(samples, selection.height_px, rest.front(),
+  const LiftoffSearch search = FindLiftoff(curve, selection.height_px, rest.front(),
                                            track.threshold_px, track.rest_noise_px,
                                            o.compression_error_px > 0);
   track.max_rise_px = search.max_rise_px;
   if (!search.not_found.empty()) return NotFoundError(search.not_found);
-  SetLiftoff(samples, selection, rest, search, o.compression_error_px, track);
+  SetLiftoff(curve, selection, rest, search, o.compression_error_px, track);
   if (o.tape_colour) {
-    track.located_by_tape = ShowsTapeColour(s.patches, selection.foot, *o.tape_colour);
+    track.located_by_tape = ShowsTapeColour(patches, selection.foot, *o.tape_colour);
     if (!track.located_by_tape) {
       track.warnings.push_back("the tracked foot does not show foot " +
                                std::string(FootName(*o.tape_colour)) +
                                "'s tape colour: check the verification image");
     }
   }
-  track.samples = std::move(samples);
+  track.samples = std::move(curve);
   return track;
 }
 
