@@ -158,8 +158,9 @@ CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,
 }
 
 Instant SunkCrossing(double rest_s, double crossing_s, double uncertainty_s) {
-  const double middle_s = 0.5 * (rest_s + crossing_s);
-  return {middle_s, std::max(uncertainty_s, crossing_s - middle_s)};
+  const double low_s = std::min(rest_s, crossing_s - uncertainty_s);
+  const double high_s = crossing_s + uncertainty_s;
+  return {0.5 * (low_s + high_s), 0.5 * (high_s - low_s)};
 }
 
 }  // namespace liftoff::video::internal

@@ -137,11 +137,12 @@ TEST(SankBefore, ACurveBelowRestBeforeItsRiseIsNotTheFootAlone) {
 TEST(SunkCrossing, TheMiddleOfTheLastRestAndTheCrossingCoveringBoth) {
   // re-drawn hard3d-06 (--seed 2000): rest to 18.467 s, then sinking; crossing at 19.042 s
   const Instant between = SunkCrossing(18.467, 19.042, 0.1);
-  EXPECT_NEAR(between.t_s, 18.7545, 1e-9);
-  EXPECT_NEAR(between.uncertainty_s, 0.2875, 1e-9);
   EXPECT_NEAR(between.t_s - between.uncertainty_s, 18.467, 1e-9);
-  // a wider uncertainty from the other terms stays
-  EXPECT_EQ(SunkCrossing(18.467, 19.042, 0.4).uncertainty_s, 0.4);
+  EXPECT_NEAR(between.t_s + between.uncertainty_s, 19.142, 1e-9);  // the crossing's own +-0.1 s
+  // an uncertainty reaching back beyond the rest frame: the crossing's own interval
+  const Instant wide = SunkCrossing(18.467, 19.042, 0.8);
+  EXPECT_NEAR(wide.t_s, 19.042, 1e-9);
+  EXPECT_NEAR(wide.uncertainty_s, 0.8, 1e-9);
 }
 
 TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
