@@ -244,6 +244,40 @@ cv::Mat Texture(cv::Size size, uint64_t seed, double low, double high) {
   return texture;
 }
 
+// Options for a hand-drawn scene: its region, a 0.5 px threshold, rest 1.0 .. 1.5 s.
+FootTracker::Options DrawnOptions(cv::Rect foot_roi_px) {
+  FootTracker::Options options;
+  options.foot_roi_px = foot_roi_px;
+  options.threshold_px = 0.5;
+  options.rest_from_ns = 1'000'000'000;
+  options.rest_to_ns = 1'500'000'000;
+  options.compression_error_px = 0;
+  return options;
+}
+
+// Tracks `count` hand-drawn 30 fps frames (`draw(t_s)`: float grey levels) and checks the
+// 0.5 px instant against truth_s: within two frames and inside its interval.
+void ExpectDrawnLiftoff(const FootTracker::Options& options, int64_t count,
+                        const std::function<cv::Mat(double)>& draw, double truth_s) {
+  FootTracker tracker(options);
+  constexpr int64_t kFrameNs = 33'333'333;
+  for (int64_t k = 0; k < count; ++k) {
+    Frame frame;
+    frame.index = k;
+    frame.t_ns = k * kFrameNs;
+    cv::Mat grey8;
+    draw(static_cast<double>(frame.t_ns) * 1e-9).convertTo(grey8, CV_8UC1);
+    cv::cvtColor(grey8, frame.bgr, cv::COLOR_GRAY2BGR);
+    ASSERT_TRUE(tracker.Process(frame).ok());
+  }
+  const Result<FootTrack> track = tracker.Finish();
+  ASSERT_TRUE(track.ok()) << track.status().ToString();
+  const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
+  EXPECT_NEAR(found_s, truth_s, 2.0 / 30) << track->Brief();
+  EXPECT_LE(std::abs(found_s - truth_s),
+            static_cast<double>(track->above_threshold.uncertainty_ns) * 1e-9 + 1e-3);
+}
+
 TEST(FootTracker, ARobotFillingTheRegionsMarginAndRisingWithTheFootIsNoGround) {
   // hand-drawn, not the renderer: a small robot whose body and other legs fill the
   // region's margin down to 8 px above the foot's bottom, rising at 0.8 times the foot's
@@ -256,35 +290,12 @@ TEST(FootTracker, ARobotFillingTheRegionsMarginAndRisingWithTheFootIsNoGround) {
   body_mask.rowRange(0, 96).setTo(1.0);
   cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
   const auto rise_px = [](double t_s) { return t_s > 3.0 ? 10 * (t_s - 3.0) * (t_s - 3.0) : 0.0; };
-  FootTracker::Options options;
-  options.foot_roi_px = cv::Rect(75, 55, 50, 50);
-  options.threshold_px = 0.5;
-  options.rest_from_ns = 1'000'000'000;
-  options.rest_to_ns = 1'500'000'000;
-  options.compression_error_px = 0;
-  FootTracker tracker(options);
-  constexpr int64_t kFrameNs = 33'333'333;
-  for (int64_t k = 0; k < 120; ++k) {
-    const double t_s = static_cast<double>(k * kFrameNs) * 1e-9;
-    const cv::Mat b = ShiftedUp(body_mask, 0.8 * rise_px(t_s)),
-                  f = ShiftedUp(foot_mask, rise_px(t_s));
-    cv::Mat grey = floor.mul(1 - b) + ShiftedUp(body, 0.8 * rise_px(t_s)).mul(b);
-    grey = grey.mul(1 - f) + ShiftedUp(foot, rise_px(t_s)).mul(f);
-    Frame frame;
-    frame.index = k;
-    frame.t_ns = k * kFrameNs;
-    cv::Mat grey8;
-    grey.convertTo(grey8, CV_8UC1);
-    cv::cvtColor(grey8, frame.bgr, cv::COLOR_GRAY2BGR);
-    ASSERT_TRUE(tracker.Process(frame).ok());
-  }
-  const Result<FootTrack> track = tracker.Finish();
-  ASSERT_TRUE(track.ok()) << track.status().ToString();
-  const double truth_s = 3.0 + std::sqrt(0.05);
-  const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
-  EXPECT_NEAR(found_s, truth_s, 2.0 / 30) << track->Brief() << " ground " << track->reference_patches_px.size() << " foot " << track->foot_patches_px.size();
-  EXPECT_LE(std::abs(found_s - truth_s),
-            static_cast<double>(track->above_threshold.uncertainty_ns) * 1e-9 + 1e-3);
+  const auto draw = [&](double t_s) {
+    const cv::Mat b = ShiftedUp(body_mask, 0.8 * rise_px(t_s)), f = ShiftedUp(foot_mask, rise_px(t_s));
+    const cv::Mat grey = floor.mul(1 - b) + ShiftedUp(body, 0.8 * rise_px(t_s)).mul(b);
+    return cv::Mat(grey.mul(1 - f) + ShiftedUp(foot, rise_px(t_s)).mul(f));
+  };
+  ExpectDrawnLiftoff(DrawnOptions(cv::Rect(75, 55, 50, 50)), 120, draw, 3.0 + std::sqrt(0.05));
 }
 
 TEST(FootTracker, APartMovedByTheBendAndLostLongBeforeTheLiftoffIsNoFoot) {
@@ -303,37 +314,15 @@ TEST(FootTracker, APartMovedByTheBendAndLostLongBeforeTheLiftoffIsNoFoot) {
   const auto rise_px = [](double t_s) { return t_s > 8.0 ? 100 * (t_s - 8.0) * (t_s - 8.0) : 0.0; };
   cv::RNG rng(7);
   cv::Mat covered(size, CV_32FC1);
-  FootTracker::Options options;
-  options.foot_roi_px = cv::Rect(70, 50, 60, 52);
-  options.threshold_px = 0.5;
-  options.rest_from_ns = 1'000'000'000;
-  options.rest_to_ns = 1'500'000'000;
-  options.compression_error_px = 0;
-  FootTracker tracker(options);
-  constexpr int64_t kFrameNs = 33'333'333;
-  for (int64_t k = 0; k < 300; ++k) {
-    const double t_s = static_cast<double>(k * kFrameNs) * 1e-9;
+  const auto draw = [&](double t_s) {
     const cv::Mat l = ShiftedUp(leg_mask, bend_px(t_s)), f = ShiftedUp(foot_mask, rise_px(t_s));
     rng.fill(covered, cv::RNG::UNIFORM, 0, 255);  // what covers them: unlike anything
     const cv::Mat leg_now = t_s < 4.0 ? ShiftedUp(leg, bend_px(t_s)) : covered;
     const cv::Mat foot_now = t_s < 8.5 ? ShiftedUp(foot, rise_px(t_s)) : covered;
-    cv::Mat grey = floor.mul(1 - l) + leg_now.mul(l);
-    grey = grey.mul(1 - f) + foot_now.mul(f);
-    Frame frame;
-    frame.index = k;
-    frame.t_ns = k * kFrameNs;
-    cv::Mat grey8;
-    grey.convertTo(grey8, CV_8UC1);
-    cv::cvtColor(grey8, frame.bgr, cv::COLOR_GRAY2BGR);
-    ASSERT_TRUE(tracker.Process(frame).ok());
-  }
-  const Result<FootTrack> track = tracker.Finish();
-  ASSERT_TRUE(track.ok()) << track.status().ToString();
-  const double truth_s = 8.0 + std::sqrt(0.005);
-  const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
-  EXPECT_NEAR(found_s, truth_s, 2.0 / 30) << track->Brief();
-  EXPECT_LE(std::abs(found_s - truth_s),
-            static_cast<double>(track->above_threshold.uncertainty_ns) * 1e-9 + 1e-3);
+    const cv::Mat grey = floor.mul(1 - l) + leg_now.mul(l);
+    return cv::Mat(grey.mul(1 - f) + foot_now.mul(f));
+  };
+  ExpectDrawnLiftoff(DrawnOptions(cv::Rect(70, 50, 60, 52)), 300, draw, 8.0 + std::sqrt(0.005));
 }
 
 TEST(FootTracker, FootThatNeverLiftsIsNotFound) {
