@@ -47,10 +47,6 @@ LogStats MeasureLog(const ControllerLog& log, int64_t gap_threshold_ns) {
   return stats;
 }
 
-nlohmann::json FiniteOrNull(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
-}
-
 // The summary as `log --json` prints it.
 nlohmann::json LogJson(const LogCommand& command, const ControllerLog& log, const LogStats& stats) {
   const std::optional<int64_t> led_ns = log.LedOnTimeNs();
@@ -67,8 +63,8 @@ nlohmann::json LogJson(const LogCommand& command, const ControllerLog& log, cons
       {"gap_threshold_s", command.gap_threshold_s},
       {"longest_gap_s", SecondsFromNs(stats.longest_gap_ns)},
       {"led_on_s", led_ns ? nlohmann::json(SecondsFromNs(*led_ns)) : nlohmann::json()},
-      {"vertebra_min_rad", FiniteOrNull(stats.min_angle_rad)},
-      {"vertebra_max_rad", FiniteOrNull(stats.max_angle_rad)},
+      {"vertebra_min_rad", NumberOrNull(stats.min_angle_rad)},
+      {"vertebra_max_rad", NumberOrNull(stats.max_angle_rad)},
       {"bad_lines", log.report.bad_lines},
       {"truncated_last_line", log.report.truncated_last_line},
   };

@@ -75,6 +75,10 @@ std::string FormatNumber(double value) {
   return out.str();
 }
 
+nlohmann::json NumberOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
 std::string DescribeNumberRange(const NumberRange& range, bool integer) {
   std::string what = integer ? "an integer" : "a number";
   const bool has_min = std::isfinite(range.min);

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
 
 namespace liftoff::stats {
@@ -24,8 +25,6 @@ Cell Interval(double low, double high) {
   if (!std::isfinite(low) || !std::isfinite(high)) return std::nullopt;
   return "[" + *Fixed3(low) + ", " + *Fixed3(high) + "]";
 }
-
-json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 std::string CalibrationLine(std::string_view calibration, std::string_view lookup_rule) {
   return "Calibration: " + std::string(calibration.empty() ? "(not named)" : calibration) +

@@ -1138,8 +1138,8 @@ std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
 // kSunkThresholds thresholds before its rise measures more than the foot (a leg tilting
 // as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
 // known to lie between the curve's last frame within a threshold of rest and the crossing
-// (a curve held down crosses late, never early): the instant moves to their middle, the
-// uncertainty covers both. Returns why, or "" when the curve did not sink.
+// with its own uncertainty (internal::SunkCrossing): the instant moves to the middle of
+// that interval. Returns why, or "" when the curve did not sink.
 std::string CheckSinking(const std::vector<HeightSample>& samples,
                          const std::vector<double>& height, const LiftoffSearch& search,
                          const FootTrack& track, double& crossing_s, double& uncertainty_s) {

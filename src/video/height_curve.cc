@@ -50,7 +50,8 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
 size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                      const std::vector<double>& smooth, size_t cut, size_t smooth_half,
                      double threshold_px, double reach_s, double reach_tops) {
-  double highest = height[cut];
+  double highest = std::isfinite(height[cut]) ? height[cut]
+                                              : -std::numeric_limits<double>::infinity();
   for (size_t f = cut + 1; f + smooth_half < smooth.size(); ++f) {
     if (Seconds(samples[f].t_ns - samples[cut].t_ns) > reach_s) break;
     if (!(smooth[f] <= reach_tops * smooth[cut])) break;

@@ -117,6 +117,10 @@ TEST(ReachKeyframe, TheFirstKeyFrameAfterTheTopUnlessTheCurveFellBackOrOutgrewTh
   std::vector<double> wobbly = height;
   wobbly[12] = height[11] - 0.4;
   EXPECT_EQ(ReachKeyframe(samples, wobbly, height, 10, 2, 0.5, 1.0, 3.0), 13u);
+  // the fall-back rule holds when the top frame itself was not measured
+  std::vector<double> lost_from_unmeasured_top = lost;
+  lost_from_unmeasured_top[10] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(ReachKeyframe(samples, lost_from_unmeasured_top, height, 10, 2, 0.5, 1.0, 3.0), 0u);
 }
 
 TEST(SankBefore, ACurveBelowRestBeforeItsRiseIsNotTheFootAlone) {

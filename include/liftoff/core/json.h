@@ -54,6 +54,9 @@ std::string DescribeNumberRange(const NumberRange& range, bool integer = false);
 bool InNumberRange(double value, const NumberRange& range);
 /// A number as people write it: 0.25, 1e-06, 1000.
 std::string FormatNumber(double value);
+/// A result number for a JSON document: the number, or null when it is not finite (JSON
+/// has no NaN or infinity, and no non-finite number is ever printed as a result).
+nlohmann::json NumberOrNull(double value);
 
 /// Reads one JSON object field by field. Each getter marks its key as read; a missing
 /// required key, a wrong type or an out-of-range value records an error naming the
