@@ -224,6 +224,9 @@ struct TinyLedStream {
   double refresh_levels = 0.0;
   int brighten_after_frames = 0;
   double brighten_factor = 1.0;
+  // The light of the first lit frames shown at these fractions of what they saw (a codec
+  // building a small spot up over a few frames), from the first lit frame on.
+  std::vector<double> build_up;
   cv::Point led_px{212, 96};
   cv::Rect Roi() const { return cv::Rect(led_px.x - 30, led_px.y - 34, 64, 64); }
   double PeriodNs() const { return 1e9 / fps; }
@@ -268,7 +271,11 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
     }
     const double on_frames = stream.on_s ? t_s * stream.fps - *stream.on_s * stream.fps : -1.0;
     const bool refined = stream.brighten_after_frames > 0 && on_frames >= stream.brighten_after_frames;
-    picture += lit * stream.light_scale * (refined ? stream.brighten_factor : 1.0) * light;
+    const auto lit_frames = static_cast<size_t>(std::ceil(on_frames + 0.5 * stream.exposure_s * stream.fps));
+    const double shown = lit > 0 && lit_frames >= 1 && lit_frames <= stream.build_up.size()
+                             ? stream.build_up[lit_frames - 1]
+                             : 1.0;
+    picture += lit * shown * stream.light_scale * (refined ? stream.brighten_factor : 1.0) * light;
     if (lit > 0 && stream.refresh_levels > 0) {
       cv::Mat pattern(size, CV_32FC3);
       cv::RNG(555).fill(pattern, cv::RNG::UNIFORM, cv::Scalar::all(-stream.refresh_levels),
@@ -376,6 +383,20 @@ TEST(LedDetector, ALedThatGoesOnBrighteningIsOneSwitchOn) {
   stream.brighten_after_frames = 8;
   stream.brighten_factor = 4;
   stream.on_s = 1.5 - 0.5 * stream.exposure_s;
+  ExpectOnePulseWithinHalfAFrame(stream);
+}
+
+// A faint tiny LED on a frozen picture, half lit in frame 45 and built up by H.264 over
+// three frames (hard3d-06 re-drawn with --seed 4000: its brightest pixel shown 0.67, 0.80,
+// 0.93 of its level, the ROI's signal 0.40, 0.60, 0.88; here 0.6, 0.7, 0.9): the frame
+// after a partly lit one still short of the level is the codec, not a transition to come.
+TEST(LedDetector, AFaintLedACodecBuildsUpOverFramesIsFound) {
+  TinyLedStream stream;
+  stream.noise_sigma = 0.0;
+  stream.flicker = false;
+  stream.light_scale = 0.05;
+  stream.build_up = {1.2, 0.7, 0.9};
+  stream.on_s = 1.5;
   ExpectOnePulseWithinHalfAFrame(stream);
 }
 
