@@ -41,7 +41,9 @@ void WriteLog(const fs::path& path, long long lines, bool lean) {
   }
 }
 
-// The peak resident memory of `liftoff <arguments>`, bytes; -1 when it failed.
+// The peak resident memory of `liftoff <arguments>`, bytes; -1 when it failed. (A child's
+// ru_maxrss is the larger of its own peak and the pages it shared with this process at the
+// fork, before its exec: exact whenever above this process' own peak, which main prints.)
 long long PeakRssBytes(const std::vector<std::string>& arguments) {
   std::vector<char*> argv;
   argv.push_back(const_cast<char*>(LIFTOFF_BINARY));
@@ -97,5 +99,8 @@ int main(int argc, char** argv) {
                 static_cast<double>(peak) / static_cast<double>(file_bytes));
   }
   fs::remove(path);
+  const long bench_kib = liftoff::bench::OwnPeakKib();
+  std::printf("(this bench's own peak %.1f MB: a peak above it is the command's own)\n",
+              Mb(static_cast<long long>(bench_kib) * 1024));
   return 0;
 }
