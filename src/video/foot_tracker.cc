@@ -111,6 +111,9 @@ constexpr double kWideUncertaintyS = 0.25;
 constexpr double kShortRiseThresholds = 3.0;
 // A key frame between still stretches of this long (and this many frames at least), each
 // within this many thresholds, renews the picture's quality only.
+// A lagging curve this many of its still noise's sigmas above the threshold for good
+// bounds the liftoff from above (BoundByTheCurve).
+constexpr double kSurelyAboveSigmas = 2.0;
 constexpr double kQuietS = 0.15;
 constexpr size_t kQuietFrames = 5;
 constexpr double kQuietThresholds = 0.1;
@@ -752,8 +755,40 @@ struct LiftoffSearch {
   double lag_bound_px = 0;             // a codec's lag allowed for, px (0: none)
   size_t fit_first = 0, fit_last = 0;  // frames fitted
   double max_rise_px = 0;              // of the smoothed curve
+  double still_noise_px = 0;           // the rest window's noise, or its key frames' if larger
   std::string not_found;               // why there is no liftoff, when there is none
 };
+
+// The first sample at or after t_ns (the last one when none is).
+size_t FrameAtOrAfter(const std::vector<HeightSample>& samples, int64_t t_ns) {
+  const auto at = std::lower_bound(samples.begin(), samples.end(), t_ns,
+                                   [](const HeightSample& s, int64_t t) { return s.t_ns < t; });
+  return at == samples.end() ? samples.size() - 1 : static_cast<size_t>(at - samples.begin());
+}
+
+// The still foot's noise, px: the rest window's, or its key frames' before the model's
+// knee when larger (internal::KeyframeNoisePx).
+double StillNoisePx(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                    size_t first, double rest_noise_px, const internal::RiseFit& fit) {
+  const size_t knee = FrameAtOrAfter(samples, RoundNs(fit.knee_low_s * 1e9));
+  return std::max(rest_noise_px, internal::KeyframeNoisePx(samples, height, first, knee));
+}
+
+// A codec's lag holds the curve back, never ahead: the foot was above the threshold once
+// the curve stood kSurelyAboveSigmas of the still noise above it for good, however the
+// model's acceptable knees ended (internal::SurelyAboveS; a key frame's offset can pull
+// them all early: re-drawn hard3d-07, --seed 4000, 0.47 px per mm, where the truth came
+// 15 ms after them). Widens the fit's crossing interval to that instant, moving its middle.
+void BoundByTheCurve(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                     double threshold_px, LiftoffSearch& search) {
+  internal::RiseFit& fit = search.fit;
+  const double above_s =
+      internal::SurelyAboveS(samples, height, search.fit_first, search.fit_last,
+                             fit.level + threshold_px, kSurelyAboveSigmas * search.still_noise_px);
+  if (!(above_s > fit.crossing_high_s)) return;
+  fit.crossing_high_s = above_s;
+  fit.crossing_middle_s = 0.5 * (fit.crossing_low_s + fit.crossing_high_s);
+}
 
 // A key frame among frames (f - half, f + half + 1], the latest; 0 for none.
 size_t KeyframeNear(const std::vector<HeightSample>& samples, size_t f, size_t half) {
@@ -924,6 +959,9 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   }
   search.fit_first = start;
   search.fit_last = std::max(cut, cut_with_key);
+  if (!search.fit.ok) return search;
+  search.still_noise_px = StillNoisePx(samples, height, first, rest_noise_px, search.fit);
+  if (search.lag_bound_px > 0) BoundByTheCurve(samples, height, threshold_px, search);
   return search;
 }
 
@@ -946,10 +984,11 @@ std::string PatchCount(size_t count) {
 
 // The liftoff instant's half-width, s, in quadrature: the spread of the acceptable knees'
 // crossings, a codec's lag (up to the bound allowed for, at least compression_error_px),
-// the registration's own error, the rest noise, the ground's drift and, with an estimated
+// the registration's own error, the still foot's noise (the rest window's, or its key
+// frames' when larger: internal::KeyframeNoisePx), the ground's drift and, with an estimated
 // scale, 3 % of the threshold, each over the model's rise rate at the crossing.
 double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
-                           double crossing_s, double compression_error_px,
+                           double crossing_s, double compression_error_px, double still_noise_px,
                            double ground_drift_px) {
   const internal::RiseFit& fit = search.fit;
   const double fit_spread =
@@ -962,7 +1001,7 @@ double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
       track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px : 0.0;
   const double px = std::sqrt(lag_px * lag_px + scale_px * scale_px +
                               kRegistrationErrorPx * kRegistrationErrorPx +
-                              track.rest_noise_px * track.rest_noise_px +
+                              still_noise_px * still_noise_px +
                               ground_drift_px * ground_drift_px);
   return std::hypot(fit_spread, px / rate);
 }
@@ -1160,13 +1199,6 @@ std::string CheckSinking(const std::vector<HeightSample>& samples,
          " s";
 }
 
-// The first sample at or after t_ns (the last one when none is).
-size_t FrameAtOrAfter(const std::vector<HeightSample>& samples, int64_t t_ns) {
-  const auto at = std::lower_bound(samples.begin(), samples.end(), t_ns,
-                                   [](const HeightSample& s, int64_t t) { return s.t_ns < t; });
-  return at == samples.end() ? samples.size() - 1 : static_cast<size_t>(at - samples.begin());
-}
-
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
 // the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
 // a drift that comes with the rise is a shadow or a part of the robot among the ground
@@ -1199,8 +1231,8 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
     if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
   }
   const double drift_px = GroundDriftPx(samples, selection.shake_px, rest, crossing_s);
-  double uncertainty_s =
-      LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
+  double uncertainty_s = LiftoffUncertaintyS(track, search, crossing_s, compression_error_px,
+                                             search.still_noise_px, drift_px);
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =

@@ -47,6 +47,19 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
   }
 }
 
+double KeyframeNoisePx(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                       size_t first, size_t last) {
+  std::vector<double> changes;
+  double previous = std::numeric_limits<double>::quiet_NaN();
+  for (size_t f = first; f < std::min(last, height.size()); ++f) {
+    if (!samples[f].keyframe || !std::isfinite(height[f])) continue;
+    if (std::isfinite(previous)) changes.push_back(std::abs(height[f] - previous));
+    previous = height[f];
+  }
+  if (changes.size() < kMinKeyframeChanges) return 0.0;
+  return 1.4826 * FiniteMedian(changes) / std::sqrt(2.0);
+}
+
 size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                      const std::vector<double>& smooth, size_t cut, size_t smooth_half,
                      double threshold_px, double reach_s, double reach_tops) {
@@ -83,6 +96,13 @@ size_t SustainedCrossing(const std::vector<double>& height, size_t first, size_t
     if (height[f] >= level && height[f + 1] >= level && height[f + 2] >= level) return f;
   }
   return last + 1;
+}
+
+double SurelyAboveS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                    size_t first, size_t last, double level, double margin_px) {
+  const size_t above = SustainedCrossing(height, first, last, level + margin_px);
+  if (above > last) return std::numeric_limits<double>::quiet_NaN();
+  return Seconds(samples[above].t_ns);
 }
 
 size_t FinalRunStart(const std::vector<double>& height, size_t first, size_t last, double level) {

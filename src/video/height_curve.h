@@ -27,6 +27,17 @@ double LevelStep(const std::vector<double>& curve, size_t key, size_t count);
 void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start, size_t cut,
                          size_t frames, double quiet_px, std::vector<double>& levelled);
 
+/// How much the curve's key frames scatter where the foot stands still (frames [first,
+/// last)), px: 1.4826 times the median of the absolute changes between consecutive key
+/// frames, over the square root of 2 (a slow drift cancels). A lossy codec copies a still
+/// picture between key frames, so a rest window without one measures no noise at all,
+/// while each key frame quantises the foot's edge anew (re-drawn hard3d-07, --seed 4000).
+/// 0 with fewer than
+/// kMinKeyframeChanges changes; in an intra-only clip every frame is a key frame.
+inline constexpr size_t kMinKeyframeChanges = 4;
+double KeyframeNoisePx(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                       size_t first, size_t last);
+
 /// The key frame soon after the fit's top (frame `cut`) that shows the foot without a
 /// codec's lag, to extend the fit to: the first within reach_s of it while the running
 /// median `smooth` stays within reach_tops times its value at the cut (a fast rise the model
@@ -50,6 +61,13 @@ double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
 /// three frames in a row at or above it; last + 1 for none.
 size_t SustainedCrossing(const std::vector<double>& height, size_t first, size_t last,
                          double level);
+
+/// When the curve surely stood above `level`, s: the time of its first sustained crossing
+/// (SustainedCrossing) of level + margin_px among frames [first, last]; NaN for none. A
+/// codec's lag holds a curve back, never ahead, so with margin_px a few sigmas of its
+/// noise the foot was above `level` by then.
+double SurelyAboveS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
+                    size_t first, size_t last, double level, double margin_px);
 
 /// The first frame of the run at or above `level` that ends at frame `last` (unmeasured
 /// frames join it); last + 1 when the curve ends below it.

@@ -158,5 +158,37 @@ TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
   EXPECT_EQ(FiniteMedian(values), 2.0);
 }
 
+TEST(KeyframeNoise, TheKeyFramesScatterWhereTheFramesBetweenCopyAStillPicture) {
+  // 60 frames, a key frame every 10: the frames between copy their key frame exactly (no
+  // noise in any window between), the key frames at 0, 0.2, -0.1, 0.1, 0.1, 0.3 px: their
+  // changes 0.2, 0.3, 0.2, 0, 0.2 have the median 0.2
+  const std::vector<double> keys = {0, 0.2, -0.1, 0.1, 0.1, 0.3};
+  std::vector<double> height(60);
+  std::vector<HeightSample> samples = Samples(height.size());
+  for (size_t f = 0; f < height.size(); ++f) {
+    height[f] = keys[f / 10];
+    samples[f].keyframe = f % 10 == 0;
+  }
+  EXPECT_NEAR(KeyframeNoisePx(samples, height, 0, 60), 1.4826 * 0.2 / std::sqrt(2.0), 1e-12);
+  // the window [0, 40) holds 4 key frames: 3 changes are too few
+  EXPECT_EQ(KeyframeNoisePx(samples, height, 0, 40), 0.0);
+  // an unmeasured key frame is skipped: changes 0.2, 0.1 (0.2 to 0.1), 0, 0.2: median 0.15
+  height[20] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NEAR(KeyframeNoisePx(samples, height, 0, 60), 1.4826 * 0.15 / std::sqrt(2.0), 1e-12);
+  // an intra-only clip: every frame a key frame, the copies' zero changes dominate
+  for (HeightSample& sample : samples) sample.keyframe = true;
+  EXPECT_EQ(KeyframeNoisePx(samples, height, 0, 60), 0.0);
+}
+
+TEST(SurelyAbove, TheFirstSustainedCrossingOfTheLevelPlusTheMargin) {
+  // a one-frame excursion to 0.9 at 3, then a rise: 0.5 at 6, 0.8 at 7, 1.0 from 8 on
+  const std::vector<double> height = {0, 0, 0, 0.9, 0, 0, 0.5, 0.8, 1.0, 1.0, 1.1};
+  const std::vector<HeightSample> samples = Samples(height.size());
+  EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.0), 6 * kFrameS, 1e-12);
+  EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.3), 7 * kFrameS, 1e-12);
+  EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.4), 8 * kFrameS, 1e-12);
+  EXPECT_TRUE(std::isnan(SurelyAboveS(samples, height, 0, 10, 0.5, 0.7)));
+}
+
 }  // namespace
 }  // namespace liftoff::video::internal
