@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "liftoff/cli/flags.h"
 #include "liftoff/core/json.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
@@ -124,20 +125,9 @@ Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
     }
     options.foot.tape_colour = *foot;
   }
-  LIFTOFF_RETURN_IF_ERROR(
-      CheckFlagRange("--px-per-mm", choice.px_per_mm, {.min = 0.0, .max = 1000.0}, "px/mm"));
-  LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--threshold-mm", choice.threshold_mm,
-                                          {.min = 0.0, .max = 100.0, .min_exclusive = true}, "mm"));
-  if (choice.threshold_px) {
-    LIFTOFF_RETURN_IF_ERROR(CheckFlagRange("--threshold-px", *choice.threshold_px,
-                                            {.min = 0.0, .max = 1000.0, .min_exclusive = true},
-                                            "px"));
-  }
-  LIFTOFF_RETURN_IF_ERROR(
-      CheckFlagRange("--exposure-ms", choice.exposure_ms, {.min = 0.0, .max = 1000.0}, "ms"));
   options.foot.px_per_mm = choice.px_per_mm;
   options.foot.threshold_mm = choice.threshold_mm;
-  options.foot.threshold_px = choice.threshold_px.value_or(0.0);
+  options.foot.threshold_px = choice.threshold_px;
   options.led.exposure_s = 1e-3 * choice.exposure_ms;
   options.foot.exposure_s = options.led.exposure_s;
   LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(choice.rest_window));
@@ -149,7 +139,15 @@ Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
                                 "\"");
   }
   options.liftoff = *instant;
-  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  const Status valid = options.Validate();
+  for (const char* field : {"led.exposure_s", "foot.exposure_s"}) {
+    if (auto named = MessageNamingFlag(valid.message(), "--exposure-ms", field, true)) {
+      return Status(valid.code(), *named);
+    }
+  }
+  LIFTOFF_RETURN_IF_ERROR(NameFlagsIn(valid, {{"--px-per-mm", "foot.px_per_mm"},
+                                              {"--threshold-mm", "foot.threshold_mm"},
+                                              {"--threshold-px", "foot.threshold_px"}}));
   return options;
 }
 

@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "liftoff/core/field_checker.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
 #include "area_resize.h"
@@ -147,36 +148,23 @@ Status FootTracker::Options::Validate() const {
                                 std::to_string(foot_roi_px.width) + " x " +
                                 std::to_string(foot_roi_px.height));
   }
-  if (!(threshold_px >= 0) || !std::isfinite(threshold_px)) {
-    return InvalidArgumentError("threshold_px: expected >= 0 (0: use threshold_mm), got " +
-                                FormatFixed(threshold_px, 3));
+  return ValidateAllButRegion();
+}
+
+Status FootTracker::Options::ValidateAllButRegion() const {
+  FieldChecker check;
+  if (threshold_px) {
+    check.Number("threshold_px", *threshold_px, {.min = 0, .max = 1000, .min_exclusive = true});
+  } else {
+    check.Number("threshold_mm", threshold_mm, {.min = 0, .max = 100, .min_exclusive = true});
   }
-  if (threshold_px == 0 && (!(threshold_mm > 0) || !std::isfinite(threshold_mm))) {
-    return InvalidArgumentError("threshold_mm: expected > 0, got " + FormatFixed(threshold_mm, 3));
-  }
-  if (!(px_per_mm >= 0) || !std::isfinite(px_per_mm)) {
-    return InvalidArgumentError("px_per_mm: expected >= 0 (0: estimate it), got " +
-                                FormatFixed(px_per_mm, 3));
-  }
-  if (!(foot_width_mm > 0) || !std::isfinite(foot_width_mm)) {
-    return InvalidArgumentError("foot_width_mm: expected > 0, got " +
-                                FormatFixed(foot_width_mm, 3));
-  }
-  if (rest_frames < 2) {
-    return InvalidArgumentError("rest_frames: expected >= 2, got " + std::to_string(rest_frames));
-  }
-  if (!(compression_error_px >= 0) || !(compression_error_px <= 10)) {
-    return InvalidArgumentError("compression_error_px: expected 0 .. 10, got " +
-                                FormatFixed(compression_error_px, 3));
-  }
-  if (!(exposure_s >= 0) || !(exposure_s <= 10)) {
-    return InvalidArgumentError("exposure_s: expected 0 (unknown) .. 10, got " +
-                                FormatFixed(exposure_s, 6));
-  }
-  if (!(min_quality >= 0 && min_quality <= 1)) {
-    return InvalidArgumentError("min_quality: expected 0 .. 1, got " + FormatFixed(min_quality, 3));
-  }
-  return Status::Ok();
+  check.Number("px_per_mm", px_per_mm, {.min = 0, .max = 1000});
+  check.Number("foot_width_mm", foot_width_mm, {.min = 0, .max = 10000, .min_exclusive = true});
+  check.Integer("rest_frames", rest_frames, {.min = 2, .max = 100000});
+  check.Number("compression_error_px", compression_error_px, {.min = 0, .max = 10});
+  check.Number("exposure_s", exposure_s, {.min = 0, .max = 10});
+  check.Number("min_quality", min_quality, {.min = 0, .max = 1});
+  return check.status();
 }
 
 std::string FootTrack::Brief() const {
@@ -1120,8 +1108,8 @@ std::vector<size_t> RestFrames(const std::vector<HeightSample>& samples, size_t 
 
 // The scale and the threshold: given, or the scale from the tracked foot's width.
 void SetScale(const FootTracker::Options& o, double foot_width_px, FootTrack& track) {
-  if (o.threshold_px > 0) {
-    track.threshold_px = o.threshold_px;
+  if (o.threshold_px) {
+    track.threshold_px = *o.threshold_px;
     track.px_per_mm = o.px_per_mm;
     return;
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -208,7 +209,7 @@ TEST(FootTracker, ShadowChangeAloneIsNotALift) {
   ASSERT_GT(cv::norm(with_shadow, without_shadow, cv::NORM_INF), 40);
 
   // at 1 mm, and even at a twentieth of a pixel
-  for (const double threshold_px : {0.0, 0.05}) {
+  for (const std::optional<double> threshold_px : {std::optional<double>(), std::optional(0.05)}) {
     FootTracker::Options options = OptionsFor(shaded);
     options.threshold_px = threshold_px;
     FootTracker tracker(options);

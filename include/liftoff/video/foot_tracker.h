@@ -143,13 +143,15 @@ class FootTracker {
     /// D red): a check reported as FootTrack::located_by_tape, never used to find it.
     std::optional<Foot> tape_colour;
     /// Threshold above rest: in mm with a scale (px_per_mm given, or estimated from the
-    /// foot's width foot_width_mm when px_per_mm is 0), or in px when threshold_px > 0
+    /// foot's width foot_width_mm when px_per_mm is 0), or in px when threshold_px is set
     /// (then mm are ignored). foot_width_mm is the width of the foot as seen from the
     /// camera, mm (a parameter of the robot, not of liftoff's synthetic block): give the
     /// real foot's width, or better px_per_mm, else the estimated scale is wrong by their
     /// ratio.
+    /// Ranges: threshold_mm (0, 100], threshold_px (0, 1000], px_per_mm 0 .. 1000,
+    /// foot_width_mm (0, 10000].
     double threshold_mm = 1.0;
-    double threshold_px = 0.0;
+    std::optional<double> threshold_px;
     double px_per_mm = 0.0;
     double foot_width_mm = 40.0;
     /// Rest window, video clock, ns: the foot's rest height is its mean over
@@ -172,6 +174,9 @@ class FootTracker {
     double min_quality = 0.5;
 
     Status Validate() const;
+    /// Validate() but for the region (a clip analysed without a foot region still checks
+    /// the rest).
+    Status ValidateAllButRegion() const;
   };
 
   explicit FootTracker(const Options& options);
