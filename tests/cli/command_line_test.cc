@@ -127,5 +127,23 @@ TEST(ClipOptionsFrom, ReadsRegionsAsXYWHAndNamesTheFlagOtherwise) {
   }
 }
 
+// The clip flags' defaults are the options' own: no flag given, no field changed.
+TEST(ClipOptionsFrom, NoFlagGivenLeavesEveryOptionAtItsDefault) {
+  auto options = ClipOptionsFrom(ClipChoice{});
+  ASSERT_TRUE(options.ok()) << options.status().ToString();
+  const video::ClipAnalysisOptions defaults;
+  EXPECT_EQ(options->led.roi_px, defaults.led.roi_px);
+  EXPECT_EQ(options->led.exposure_s, defaults.led.exposure_s);
+  EXPECT_EQ(options->foot.foot_roi_px, defaults.foot.foot_roi_px);
+  EXPECT_EQ(options->foot.tape_colour, defaults.foot.tape_colour);
+  EXPECT_EQ(options->foot.px_per_mm, defaults.foot.px_per_mm);
+  EXPECT_EQ(options->foot.threshold_mm, defaults.foot.threshold_mm);
+  EXPECT_EQ(options->foot.threshold_px, defaults.foot.threshold_px);
+  EXPECT_EQ(options->foot.exposure_s, defaults.foot.exposure_s);
+  EXPECT_EQ(options->rest_from_led_s, defaults.rest_from_led_s);
+  EXPECT_EQ(options->rest_to_led_s, defaults.rest_to_led_s);
+  EXPECT_EQ(options->liftoff, defaults.liftoff);
+}
+
 }  // namespace
 }  // namespace liftoff::cli
