@@ -109,7 +109,12 @@ constexpr size_t kFewFootPatches = 3;
 constexpr size_t kFewGroundPatches = 3;
 constexpr double kNoisyFraction = 0.5;
 constexpr double kWideUncertaintyS = 0.25;
-constexpr double kShortRiseThresholds = 3.0;
+constexpr double kShortRiseThresholds = 6.0;
+// A foot that lifts goes on rising: through a lossy codec, a curve that never gets this many
+// thresholds above rest did not lift (a codec renewing a still picture can move a small
+// foot's edge by a threshold or more: the never-lifting d12 of shared/video-dev, encoded
+// again by OpenCV's H.264 writer, held 3 thresholds up for its last 13 s).
+constexpr double kMinLiftThresholds = 4.0;
 // A key frame between still stretches of this long (and this many frames at least), each
 // within this many thresholds, renews the picture's quality only.
 // A lagging curve this many of its still noise's sigmas above the threshold for good
@@ -889,6 +894,13 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                        FormatFixed(search.max_rise_px, 2) + " px above rest, below the " +
                        FormatFixed(threshold_px, 2) + " px threshold held for " +
                        FormatFixed(kSustainS, 1) + " s";
+    return search;
+  }
+  if (lossy && search.max_rise_px < kMinLiftThresholds * threshold_px) {
+    search.not_found = "the foot never lifts: its largest rise is " +
+                       FormatFixed(search.max_rise_px, 2) + " px above rest, under " +
+                       FormatFixed(kMinLiftThresholds, 0) + " times the " +
+                       FormatFixed(threshold_px, 2) + " px threshold (a lift goes on rising)";
     return search;
   }
   const size_t cut_with_key =

@@ -68,6 +68,11 @@ ClipScore ScoreClip(const fs::path& folder) {
     score.status = events.status();
     return score;
   }
+  if (!score.expect_ok) {  // a reject clip has no truth to score against
+    score.status = Status(StatusCode::kOutOfRange, "a reject clip was not rejected: " +
+                                                       analysis->foot->Brief());
+    return score;
+  }
   const std::vector<double> pts = truth.at("pts").get<std::vector<double>>();
   const double frame_s = (pts.back() - pts.front()) / static_cast<double>(pts.size() - 1);
   const double t_led_s = truth.at("t_led_on").get<double>();
