@@ -297,6 +297,7 @@ json FootJson(const video::FootTrack& f) {
           {"located_by_tape", f.located_by_tape},
           {"rest_rise_px", Number(f.rest_rise_px)},
           {"rest_noise_px", Number(f.rest_noise_px)},
+          {"still_noise_px", Number(f.still_noise_px)},
           {"px_per_mm", Number(f.px_per_mm)},
           {"px_per_mm_estimated", f.px_per_mm_estimated},
           {"threshold_px", Number(f.threshold_px)},
@@ -324,6 +325,7 @@ video::FootTrack FootAt(const json& j) {
   f.located_by_tape = j.at("located_by_tape").get<bool>();
   f.rest_rise_px = NumberAt(j, "rest_rise_px");
   f.rest_noise_px = NumberAt(j, "rest_noise_px");
+  f.still_noise_px = NumberAt(j, "still_noise_px");
   f.px_per_mm = NumberAt(j, "px_per_mm");
   f.px_per_mm_estimated = j.at("px_per_mm_estimated").get<bool>();
   f.threshold_px = NumberAt(j, "threshold_px");

@@ -328,8 +328,8 @@ std::vector<CLI::Option*> AddClipFlags(CLI::App& app, ClipChoice& clip) {
           ->capture_default_str();
   options.push_back(threshold_mm);
   options.push_back(app.add_option("--threshold-px", clip.threshold_px,
-                                   "Liftoff threshold above rest, px (> 0; instead of "
-                                   "--threshold-mm)")
+                                   "Liftoff threshold above rest, px, in (0, 1000] (instead "
+                                   "of --threshold-mm)")
                         ->excludes(threshold_mm));
   options.push_back(app.add_option("--exposure-ms", clip.exposure_ms,
                                    "Camera exposure per frame, ms, at most the frame interval "

@@ -294,8 +294,8 @@ std::optional<LiftoffInstant> ParseLiftoffInstant(std::string_view text) {
 Status ClipAnalysisOptions::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(reader.Validate().WithContext("reader"));
   LIFTOFF_RETURN_IF_ERROR(led.Validate().WithContext("led"));
-  LIFTOFF_RETURN_IF_ERROR(
-      (foot.foot_roi_px.empty() ? foot.ValidateAllButRegion() : foot.Validate()).WithContext("foot"));
+  const Status foot_valid = foot.foot_roi_px.empty() ? foot.ValidateAllButRegion() : foot.Validate();
+  LIFTOFF_RETURN_IF_ERROR(foot_valid.WithContext("foot"));
   const auto check = [](std::string_view field, double value, const NumberRange& range) {
     if (InNumberRange(value, range)) return Status::Ok();
     return InvalidArgumentError(std::string(field) + ": expected " + DescribeNumberRange(range) +
@@ -412,6 +412,7 @@ json ClipAnalysis::ToJson() const {
         {"rest_frames", rest_frames},
         {"rest_rise_px", foot->rest_rise_px},
         {"rest_noise_px", foot->rest_noise_px},
+        {"still_noise_px", foot->still_noise_px},
         {"max_rise_px", foot->max_rise_px},
         {"exposure_offset_ms", 1e-6 * static_cast<double>(foot->exposure_offset_ns)},
         {"poor_frames", foot->poor_frames},

@@ -113,13 +113,13 @@ constexpr double kShortRiseThresholds = 6.0;
 // A foot that lifts goes on rising: through a lossy codec, a curve that never gets this many
 // thresholds above rest did not lift (a codec renewing a still picture can move a small
 // foot's edge by a threshold or more: the never-lifting d12 of shared/video-dev, encoded
-// again by OpenCV's H.264 writer, held 3 thresholds up for its last 13 s).
+// again by OpenCV's H.264 writer, stayed above the threshold to its end).
 constexpr double kMinLiftThresholds = 4.0;
-// A key frame between still stretches of this long (and this many frames at least), each
-// within this many thresholds, renews the picture's quality only.
-// A lagging curve this many of its still noise's sigmas above the threshold for good
+// A lagging curve this many of its still noise's sigmas above the threshold (three frames)
 // bounds the liftoff from above (BoundByTheCurve).
 constexpr double kSurelyAboveSigmas = 2.0;
+// A key frame between still stretches of this long (and this many frames at least), each
+// within this many thresholds, renews the picture's quality only.
 constexpr double kQuietS = 0.15;
 constexpr size_t kQuietFrames = 5;
 constexpr double kQuietThresholds = 0.1;
@@ -768,10 +768,11 @@ double StillNoisePx(const std::vector<HeightSample>& samples, const std::vector<
 }
 
 // A codec's lag holds the curve back, never ahead: the foot was above the threshold once
-// the curve stood kSurelyAboveSigmas of the still noise above it for good, however the
-// model's acceptable knees ended (internal::SurelyAboveS; a key frame's offset can pull
-// them all early: re-drawn hard3d-07, --seed 4000, 0.47 px per mm, where the truth came
-// 15 ms after them). Widens the fit's crossing interval to that instant, moving its middle.
+// the curve stood kSurelyAboveSigmas of the still noise above it for three frames in a
+// row (internal::SurelyAboveS), however the model's acceptable knees ended (a key frame's
+// offset can pull them all early: re-drawn hard3d-07, --seed 4000, 0.47 px per mm, where
+// the truth came 15 ms after them). Widens the fit's crossing interval to that instant,
+// moving its middle.
 void BoundByTheCurve(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                      double threshold_px, LiftoffSearch& search) {
   internal::RiseFit& fit = search.fit;
@@ -879,6 +880,22 @@ size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector
   return start;
 }
 
+// Why the foot never lifts, or "" when it may have: no rise held above the threshold
+// (`no_cut`), or, through a lossy codec, none that got kMinLiftThresholds up.
+std::string NeverLifts(bool no_cut, double max_rise_px, double threshold_px, bool lossy) {
+  const std::string largest =
+      "the foot never lifts: its largest rise is " + FormatFixed(max_rise_px, 2) + " px above rest";
+  if (no_cut) {
+    return largest + ", below the " + FormatFixed(threshold_px, 2) + " px threshold held for " +
+           FormatFixed(kSustainS, 1) + " s";
+  }
+  if (lossy && max_rise_px < kMinLiftThresholds * threshold_px) {
+    return largest + ", under " + FormatFixed(kMinLiftThresholds, 0) + " times the " +
+           FormatFixed(threshold_px, 2) + " px threshold (a lift goes on rising)";
+  }
+  return "";
+}
+
 LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                           const std::vector<double>& height, size_t first, double threshold_px,
                           double rest_noise_px, bool lossy) {
@@ -889,20 +906,8 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
     if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
   }
   const size_t cut = FindCut(samples, smooth, first, threshold_px, lossy);
-  if (cut == smooth.size()) {
-    search.not_found = "the foot never lifts: its largest rise is " +
-                       FormatFixed(search.max_rise_px, 2) + " px above rest, below the " +
-                       FormatFixed(threshold_px, 2) + " px threshold held for " +
-                       FormatFixed(kSustainS, 1) + " s";
-    return search;
-  }
-  if (lossy && search.max_rise_px < kMinLiftThresholds * threshold_px) {
-    search.not_found = "the foot never lifts: its largest rise is " +
-                       FormatFixed(search.max_rise_px, 2) + " px above rest, under " +
-                       FormatFixed(kMinLiftThresholds, 0) + " times the " +
-                       FormatFixed(threshold_px, 2) + " px threshold (a lift goes on rising)";
-    return search;
-  }
+  search.not_found = NeverLifts(cut == smooth.size(), search.max_rise_px, threshold_px, lossy);
+  if (!search.not_found.empty()) return search;
   const size_t cut_with_key =
       lossy ? internal::ReachKeyframe(samples, height, smooth, cut, smooth_half, threshold_px,
                                       kKeyframeReachS, kKeyframeReachTops)
@@ -1231,8 +1236,9 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
     if (local_s >= fit.crossing_low_s && local_s <= fit.crossing_high_s) crossing_s = local_s;
   }
   const double drift_px = GroundDriftPx(samples, selection.shake_px, rest, crossing_s);
+  track.still_noise_px = search.still_noise_px;
   double uncertainty_s = LiftoffUncertaintyS(track, search, crossing_s, compression_error_px,
-                                             search.still_noise_px, drift_px);
+                                             track.still_noise_px, drift_px);
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =

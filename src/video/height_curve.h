@@ -32,8 +32,8 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
 /// frames, over the square root of 2 (a slow drift cancels). A lossy codec copies a still
 /// picture between key frames, so a rest window without one measures no noise at all,
 /// while each key frame quantises the foot's edge anew (re-drawn hard3d-07, --seed 4000).
-/// 0 with fewer than
-/// kMinKeyframeChanges changes; in an intra-only clip every frame is a key frame.
+/// 0 with fewer than kMinKeyframeChanges changes; in an intra-only clip every frame is a key
+/// frame.
 inline constexpr size_t kMinKeyframeChanges = 4;
 double KeyframeNoisePx(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                        size_t first, size_t last);
@@ -63,9 +63,12 @@ size_t SustainedCrossing(const std::vector<double>& height, size_t first, size_t
                          double level);
 
 /// When the curve surely stood above `level`, s: the time of its first sustained crossing
-/// (SustainedCrossing) of level + margin_px among frames [first, last]; NaN for none. A
-/// codec's lag holds a curve back, never ahead, so with margin_px a few sigmas of its
-/// noise the foot was above `level` by then.
+/// of level + margin_px among frames [first, last] (SustainedCrossing: three frames in a
+/// row at or above it); NaN for none. A codec's lag holds a curve back, never ahead, so
+/// with margin_px a few sigmas of its noise the foot was above `level` by then. (Not the
+/// start of the final run above it: on re-drawn hard3d-04, --seed 2000, that moved the
+/// estimate from +0.0003 to +0.0060 rad; an earlier excursion of three frames only leaves
+/// the fit's interval as it was.)
 double SurelyAboveS(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                     size_t first, size_t last, double level, double margin_px);
 

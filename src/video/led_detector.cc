@@ -981,11 +981,14 @@ std::optional<WindowShape> LedDetector::Impl::CleanStep(int region, int64_t k, b
       shape.after_creep > kCreepFrac * step) {
     return std::nullopt;
   }
-  // a partly lit frame just after a still dark k is the next frame's transition: wait for
-  // it (after a partly lit k it is a codec building up a small spot over a few frames)
+  // a partly lit frame just after a k still at the old level is the next frame's
+  // transition: wait for it (after a partly lit k it is a codec building up a small spot
+  // over a few frames)
+  const bool old_level_at_k = std::abs(*before_end - shape.before_level) <= flat * step;
+  if (old_level_at_k && std::abs(*after - shape.after_level) > 0.5 * flat * step) {
+    return std::nullopt;
+  }
   const double off = rise ? shape.before_level : shape.after_level;
-  const bool dark_at_k = std::abs(*before_end - off) <= flat * step;
-  if (dark_at_k && std::abs(*after - shape.after_level) > 0.5 * flat * step) return std::nullopt;
   const double threshold = off + options.threshold_frac * step;
   if (rise ? !(*before_high<threshold&& * after_low> threshold)
            : !(*before_low > threshold && *after_high < threshold)) {

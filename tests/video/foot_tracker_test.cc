@@ -487,6 +487,9 @@ TEST(FootTracker, NoiseFlickerAndMotionBlurKeepTheInstantWithinThreeFramesAndIts
   Result<FootTrack> track = TrackClip(scene, OptionsFor(scene));
   ASSERT_TRUE(track.ok()) << track.status().ToString();
   EXPECT_LT(track->rest_noise_px, 0.05);
+  // every frame lossless, a key frame: their scatter is the frames' own noise
+  EXPECT_GE(track->still_noise_px, track->rest_noise_px);
+  EXPECT_LT(track->still_noise_px, 0.05);
   EXPECT_LT(std::abs(track->above_threshold.t_ns - TruthNsAboveMm(scene, 1.0)),
             3 * scene.frame_ns)
       << track->Brief();

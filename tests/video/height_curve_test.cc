@@ -181,13 +181,15 @@ TEST(KeyframeNoise, TheKeyFramesScatterWhereTheFramesBetweenCopyAStillPicture) {
 }
 
 TEST(SurelyAbove, TheFirstSustainedCrossingOfTheLevelPlusTheMargin) {
-  // a one-frame excursion to 0.9 at 3, then a rise: 0.5 at 6, 0.8 at 7, 1.0 from 8 on
-  const std::vector<double> height = {0, 0, 0, 0.9, 0, 0, 0.5, 0.8, 1.0, 1.0, 1.1};
+  // a two-frame excursion to 0.9 at 2..3, back to rest, then a rise: 0.5 at 6, 0.8 at 7,
+  // 1.0 from 8 on
+  const std::vector<double> height = {0, 0, 0.9, 0.9, 0, 0, 0.5, 0.8, 1.0, 1.0, 1.1};
   const std::vector<HeightSample> samples = Samples(height.size());
   EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.0), 6 * kFrameS, 1e-12);
   EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.3), 7 * kFrameS, 1e-12);
+  // not the excursion: two frames are no sustained crossing
   EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.4), 8 * kFrameS, 1e-12);
-  EXPECT_TRUE(std::isnan(SurelyAboveS(samples, height, 0, 10, 0.5, 0.7)));
+  EXPECT_TRUE(std::isnan(SurelyAboveS(samples, height, 0, 10, 0.5, 0.7)));  // never
 }
 
 }  // namespace

@@ -271,9 +271,11 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
     }
     const double on_frames = stream.on_s ? t_s * stream.fps - *stream.on_s * stream.fps : -1.0;
     const bool refined = stream.brighten_after_frames > 0 && on_frames >= stream.brighten_after_frames;
-    const auto lit_frames = static_cast<size_t>(std::ceil(on_frames + 0.5 * stream.exposure_s * stream.fps));
-    const double shown = lit > 0 && lit_frames >= 1 && lit_frames <= stream.build_up.size()
-                             ? stream.build_up[lit_frames - 1]
+    // (the how-manieth lit frame this is, 1 for the first)
+    const double lit_frames = std::ceil(on_frames + 0.5 * stream.exposure_s * stream.fps);
+    const double shown = lit > 0 && lit_frames >= 1 &&
+                                 lit_frames <= static_cast<double>(stream.build_up.size())
+                             ? stream.build_up[static_cast<size_t>(lit_frames) - 1]
                              : 1.0;
     picture += lit * shown * stream.light_scale * (refined ? stream.brighten_factor : 1.0) * light;
     if (lit > 0 && stream.refresh_levels > 0) {

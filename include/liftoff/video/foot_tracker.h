@@ -102,6 +102,9 @@ struct FootTrack {
   /// Rest: mean rise over the rest window, px, and its noise (standard deviation), px.
   double rest_rise_px = 0.0;
   double rest_noise_px = 0.0;
+  /// The still foot's noise the liftoff's uncertainty counts, px: rest_noise_px, or the key
+  /// frames' scatter before the rise when larger (a lossy codec's copied frames show none).
+  double still_noise_px = 0.0;
   /// Scale used, px per mm (0 when the threshold was given in px), and whether it was
   /// estimated from the foot's width rather than given.
   double px_per_mm = 0.0;

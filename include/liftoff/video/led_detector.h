@@ -41,7 +41,8 @@
 //
 // In both, a step counts when the signal jumps and holds: the 4 frames before it (the last
 // may be partly lit already) and the min_on_frames after it (which may creep on by half the
-// step, even after a partly lit frame: a codec building up a small spot) are flat compared with the step, it crosses threshold_frac of the way in one frame
+// step, even after a partly lit frame: a codec building up a small spot) are flat compared
+// with the step, it crosses threshold_frac of the way in one frame
 // (or two), the LED's contrast reaches min_contrast_levels, the step stands out from what
 // the rest of the frame did at that instant (codec key frames, lighting changes and shake
 // step many regions at once; with an ROI, a step whose largest pixel step is 4 times the
