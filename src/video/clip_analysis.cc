@@ -294,7 +294,8 @@ std::optional<LiftoffInstant> ParseLiftoffInstant(std::string_view text) {
 Status ClipAnalysisOptions::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(reader.Validate().WithContext("reader"));
   LIFTOFF_RETURN_IF_ERROR(led.Validate().WithContext("led"));
-  const Status foot_valid = foot.foot_roi_px.empty() ? foot.ValidateAllButRegion() : foot.Validate();
+  const Status foot_valid =
+      foot.foot_roi_px.empty() ? foot.ValidateAllButRegion() : foot.Validate();
   LIFTOFF_RETURN_IF_ERROR(foot_valid.WithContext("foot"));
   const auto check = [](std::string_view field, double value, const NumberRange& range) {
     if (InNumberRange(value, range)) return Status::Ok();

@@ -993,7 +993,7 @@ std::string PatchCount(size_t count) {
 // frames' when larger: internal::KeyframeNoisePx), the ground's drift and, with an estimated
 // scale, 3 % of the threshold, each over the model's rise rate at the crossing.
 double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
-                           double crossing_s, double compression_error_px, double still_noise_px,
+                           double crossing_s, double compression_error_px,
                            double ground_drift_px) {
   const internal::RiseFit& fit = search.fit;
   const double fit_spread =
@@ -1006,7 +1006,7 @@ double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
       track.px_per_mm_estimated ? kEstimatedScaleFraction * track.threshold_px : 0.0;
   const double px = std::sqrt(lag_px * lag_px + scale_px * scale_px +
                               kRegistrationErrorPx * kRegistrationErrorPx +
-                              still_noise_px * still_noise_px +
+                              track.still_noise_px * track.still_noise_px +
                               ground_drift_px * ground_drift_px);
   return std::hypot(fit_spread, px / rate);
 }
@@ -1237,8 +1237,8 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   }
   const double drift_px = GroundDriftPx(samples, selection.shake_px, rest, crossing_s);
   track.still_noise_px = search.still_noise_px;
-  double uncertainty_s = LiftoffUncertaintyS(track, search, crossing_s, compression_error_px,
-                                             track.still_noise_px, drift_px);
+  double uncertainty_s =
+      LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =

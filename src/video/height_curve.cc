@@ -49,15 +49,11 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
 
 double KeyframeNoisePx(const std::vector<HeightSample>& samples, const std::vector<double>& height,
                        size_t first, size_t last) {
-  std::vector<double> changes;
-  double previous = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> keys;
   for (size_t f = first; f < std::min(last, height.size()); ++f) {
-    if (!samples[f].keyframe || !std::isfinite(height[f])) continue;
-    if (std::isfinite(previous)) changes.push_back(std::abs(height[f] - previous));
-    previous = height[f];
+    if (samples[f].keyframe && std::isfinite(height[f])) keys.push_back(height[f]);
   }
-  if (changes.size() < kMinKeyframeChanges) return 0.0;
-  return 1.4826 * FiniteMedian(changes) / std::sqrt(2.0);
+  return keys.size() > kMinKeyframeChanges ? SuccessiveDifferenceSigma(keys) : 0.0;
 }
 
 size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector<double>& height,

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -40,6 +42,16 @@ T MedianOf(T* values, std::ptrdiff_t count) {
 template <typename T>
 T MedianOf(std::vector<T> values) {
   return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
+}
+
+// A series' noise, robustly, from its successive differences: 1.4826 times their median
+// absolute value over the square root of 2 (a Gaussian noise's standard deviation; a slow
+// drift adds only its change per step, not its whole course); 0 for fewer than two values.
+inline double SuccessiveDifferenceSigma(const std::vector<double>& series) {
+  if (series.size() < 2) return 0.0;
+  std::vector<double> changes(series.size() - 1);
+  for (size_t i = 1; i < series.size(); ++i) changes[i - 1] = std::abs(series[i] - series[i - 1]);
+  return 1.4826 * MedianOf(std::move(changes)) / std::sqrt(2.0);
 }
 
 // While alive, OpenCV's own log is silent (it reports failed opens and missing backends as

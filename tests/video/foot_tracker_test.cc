@@ -301,7 +301,8 @@ TEST(FootTracker, ARobotFillingTheRegionsMarginAndRisingWithTheFootIsNoGround) {
   cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
   const auto rise_px = [](double t_s) { return t_s > 3.0 ? 10 * (t_s - 3.0) * (t_s - 3.0) : 0.0; };
   const auto draw = [&](double t_s) {
-    const cv::Mat b = ShiftedUp(body_mask, 0.8 * rise_px(t_s)), f = ShiftedUp(foot_mask, rise_px(t_s));
+    const cv::Mat b = ShiftedUp(body_mask, 0.8 * rise_px(t_s));
+    const cv::Mat f = ShiftedUp(foot_mask, rise_px(t_s));
     const cv::Mat grey = floor.mul(1 - b) + ShiftedUp(body, 0.8 * rise_px(t_s)).mul(b);
     return cv::Mat(grey.mul(1 - f) + ShiftedUp(foot, rise_px(t_s)).mul(f));
   };

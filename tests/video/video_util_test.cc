@@ -3,6 +3,7 @@
 #include "video_util.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -40,6 +41,21 @@ TEST(MedianOf, AveragesTheMiddleTwoAndHandlesEdges) {
   EXPECT_EQ(MedianOf(std::vector<int64_t>{1, 2, 3, 4}), 2);
   std::vector<double> part = {9.0, 1.0, 5.0, -7.0, 100.0};
   EXPECT_EQ(MedianOf(part.data(), 3), 5.0) << "only the first `count` values count";
+}
+
+TEST(SuccessiveDifferenceSigma, TheMedianChangeScaledToAGaussiansSigma) {
+  // changes 1, 1, 3, 1: median 1
+  EXPECT_NEAR(SuccessiveDifferenceSigma({0, 1, 0, 3, 2}), 1.4826 / std::sqrt(2.0), 1e-12);
+  // a steady drift of 0.5 a step: only its step counts, not its 1.5 course
+  EXPECT_EQ(SuccessiveDifferenceSigma({0, 0.5, 1.0, 1.5}), 1.4826 * 0.5 / std::sqrt(2.0));
+  EXPECT_EQ(SuccessiveDifferenceSigma({7}), 0.0);
+  EXPECT_EQ(SuccessiveDifferenceSigma({}), 0.0);
+  // unit Gaussian noise: within 5 % with 20,000 samples
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gaussian;
+  std::vector<double> noise(20000);
+  for (double& value : noise) value = gaussian(rng);
+  EXPECT_NEAR(SuccessiveDifferenceSigma(noise), 1.0, 0.05);
 }
 
 }  // namespace
