@@ -33,13 +33,14 @@ function(liftoff_add_module name)
   liftoff_set_warnings(liftoff_${name})
 endfunction()
 
-# liftoff_add_test(NAME SOURCES ... DEPS ... [RESOURCE_LOCK name] [FIXTURE name]):
+# liftoff_add_test(NAME SOURCES ... DEPS ... [RESOURCE_LOCK name] [FIXTURE name] [ONE_PROCESS]):
 # one GoogleTest executable per module.
 # Tests sharing a RESOURCE_LOCK never run at the same time under `ctest -j`
 # (pseudo-terminal numbers are reused across processes); FIXTURE names a CTest fixture
-# every test of the executable requires (its setup runs once per ctest run).
+# every test of the executable requires (its setup runs once per ctest run). ONE_PROCESS
+# registers the executable as one ctest test instead of one per GoogleTest test.
 function(liftoff_add_test name)
-  cmake_parse_arguments(ARG "" "RESOURCE_LOCK;FIXTURE" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "ONE_PROCESS" "RESOURCE_LOCK;FIXTURE" "SOURCES;DEPS" ${ARGN})
   set(extra_properties "")
   if(ARG_RESOURCE_LOCK)
     list(APPEND extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
@@ -50,8 +51,16 @@ function(liftoff_add_test name)
   add_executable(${name}_test ${ARG_SOURCES})
   target_link_libraries(${name}_test PRIVATE ${ARG_DEPS} liftoff_test_support GTest::gtest_main GTest::gmock)
   liftoff_set_warnings(${name}_test)
-  gtest_discover_tests(${name}_test
-    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${extra_properties}
-    DISCOVERY_TIMEOUT 60)
+  if(ARG_ONE_PROCESS)
+    # one ctest test for the whole executable: its tests share one costly analysis (a
+    # function-local static), which one process per test would repeat for each
+    add_test(NAME ${name} COMMAND ${name}_test WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(${name} PROPERTIES
+      ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${extra_properties})
+  else()
+    gtest_discover_tests(${name}_test
+      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+      PROPERTIES ENVIRONMENT "LIFTOFF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" ${extra_properties}
+      DISCOVERY_TIMEOUT 60)
+  endif()
 endfunction()

@@ -57,13 +57,13 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err) 
   return kExitOk;
 }
 
-Subcommand AddCalibCommand(CLI::App& parent) {
+Subcommand AddCalibCommand(Command& parent) {
   auto command = std::make_shared<CalibCommand>();
-  CLI::App* app =
-      parent.add_subcommand("calib", "Show a calibration, its provenance and its conversions");
-  app->add_option("calibration", command->calibration.calibration_path,
+  Command* app =
+      parent.AddSubcommand("calib", "Show a calibration, its provenance and its conversions");
+  app->AddOption("calibration", command->calibration.calibration_path,
                   "Calibration JSON (default: calib/laika-2018.json)");
-  app->add_flag("--json", command->json, "Print the calibration as JSON");
+  app->AddSwitch("--json", command->json, "Print the calibration as JSON");
   return RunsWith(app, command, RunCalib);
 }
 

@@ -79,32 +79,32 @@ int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& e
   return kExitOk;
 }
 
-Subcommand AddCaptureCommand(CLI::App& parent) {
+Subcommand AddCaptureCommand(Command& parent) {
   auto command = std::make_shared<CaptureCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "capture", "Record a test from the controller's serial port: raw journal + controller log");
-  app->add_option("port", command->port, "Serial port: device path, stable id or symlink")
-      ->required();
-  app->add_option("--output,-o", command->log_path, "Controller log to write")->required();
-  app->add_option("--journal", command->journal_path, "Raw journal (default: LOG.journal)");
-  app->add_flag("--force", command->force,
+  app->AddOption("port", command->port, "Serial port: device path, stable id or symlink")
+      ->Required();
+  app->AddOption("--output,-o", command->log_path, "Controller log to write")->Required();
+  app->AddOption("--journal", command->journal_path, "Raw journal (default: LOG.journal)");
+  app->AddSwitch("--force", command->force,
                 "Replace an existing log and journal (an earlier recording)");
-  app->add_option("--baud", command->baud_rate, "Line speed, bits/s")->capture_default_str();
-  app->add_flag("--start", command->send_start,
+  app->AddOption("--baud", command->baud_rate, "Line speed, bits/s")->ShowDefault();
+  app->AddSwitch("--start", command->send_start,
                 "Send START with the test parameters and record them in the log");
   AddTestFlags(*app, command->test);
-  app->add_option("--max-duration", command->max_duration_s, "Stop after this long, s")
-      ->capture_default_str();
-  app->add_option("--first-frame-timeout", command->first_frame_timeout_s,
+  app->AddOption("--max-duration", command->max_duration_s, "Stop after this long, s")
+      ->ShowDefault();
+  app->AddOption("--first-frame-timeout", command->first_frame_timeout_s,
                   "Fail when no frame arrives this long after opening, s (0: wait for ever)")
-      ->capture_default_str();
-  app->add_flag("--no-stop-on-test-end", command->no_stop_on_test_end,
+      ->ShowDefault();
+  app->AddSwitch("--no-stop-on-test-end", command->no_stop_on_test_end,
                 "Keep capturing after the controller's TEST_END");
-  app->add_option("--reconnect-poll", command->reconnect_poll_s,
+  app->AddOption("--reconnect-poll", command->reconnect_poll_s,
                   "Look for an unplugged port this often, s")
-      ->capture_default_str();
-  app->add_option("--status", command->status, "Status line: auto, live, lines or off")
-      ->capture_default_str();
+      ->ShowDefault();
+  app->AddOption("--status", command->status, "Status line: auto, live, lines or off")
+      ->ShowDefault();
   AddCalibrationFlag(*app, command->calibration);
   return RunsWith(app, command, RunCapture);
 }

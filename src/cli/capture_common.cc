@@ -53,16 +53,16 @@ Result<capture::TestParameters> TestParametersFrom(const TestChoice& choice) {
   return test;
 }
 
-void AddTestFlags(CLI::App& app, TestChoice& test) {
-  app.add_option("--pulled", test.pulled_group, "Cable group the bend pulls: HR or HL")
-      ->capture_default_str();
-  app.add_option("--bend-percent", test.bend_percent,
+void AddTestFlags(Command& app, TestChoice& test) {
+  app.AddOption("--pulled", test.pulled_group, "Cable group the bend pulls: HR or HL")
+      ->ShowDefault();
+  app.AddOption("--bend-percent", test.bend_percent,
                  "Bend each cable of the group to this percentage of its rest length")
-      ->capture_default_str();
-  app.add_option("--ramp-deg", test.ramp_deg,
+      ->ShowDefault();
+  app.AddOption("--ramp-deg", test.ramp_deg,
                  "Rotating vertebra's ramp amplitude, degrees, signed by direction")
-      ->capture_default_str();
-  app.add_option("--ramp-s", test.ramp_s, "Ramp duration, seconds")->capture_default_str();
+      ->ShowDefault();
+  app.AddOption("--ramp-s", test.ramp_s, "Ramp duration, seconds")->ShowDefault();
 }
 
 }  // namespace liftoff::cli

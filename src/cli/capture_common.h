@@ -35,6 +35,6 @@ class ScopedStopSignals {
 Result<capture::TestParameters> TestParametersFrom(const TestChoice& choice);
 
 /// --pulled, --bend-percent, --ramp-deg, --ramp-s, bound to `test`.
-void AddTestFlags(CLI::App& app, TestChoice& test);
+void AddTestFlags(Command& app, TestChoice& test);
 
 }  // namespace liftoff::cli

@@ -49,25 +49,25 @@ Result<stats::TableFormat> TableFormatFlag(const std::string& text) {
   return InvalidArgumentError("--format: expected md, csv, latex or json, got \"" + text + "\"");
 }
 
-void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice) {
-  app.add_option("--calibration,-c", choice.calibration_path,
+void AddCalibrationFlag(Command& app, CalibrationChoice& choice) {
+  app.AddOption("--calibration,-c", choice.calibration_path,
                  "Calibration JSON (default: the manifest's, else calib/laika-2018.json)");
 }
 
-void AddLookupFlags(CLI::App& app, LookupChoice& lookup) {
-  app.add_option("--rule", lookup.rule,
+void AddLookupFlags(Command& app, LookupChoice& lookup) {
+  app.AddOption("--rule", lookup.rule,
                  "Angle lookup: linear (interpolate) or hold (last sample at or before, the "
                  "2018 authors' rule)")
-      ->capture_default_str();
-  app.add_option("--gap-threshold", lookup.gap_threshold_s,
+      ->ShowDefault();
+  app.AddOption("--gap-threshold", lookup.gap_threshold_s,
                  "Samples further apart than this bracket a gap, seconds")
-      ->capture_default_str();
-  app.add_option("--max-past-end", lookup.max_past_end_s,
+      ->ShowDefault();
+  app.AddOption("--max-past-end", lookup.max_past_end_s,
                  "Answer lookups up to this far past the log's last sample, seconds")
-      ->capture_default_str();
-  app.add_option("--max-bad-lines", lookup.max_bad_lines,
+      ->ShowDefault();
+  app.AddOption("--max-bad-lines", lookup.max_bad_lines,
                  "Malformed log lines to skip (reported) before a log is rejected")
-      ->capture_default_str();
+      ->ShowDefault();
 }
 
 Status NameFlagsIn(const Status& status,

@@ -52,12 +52,12 @@ Status CheckLookupFlags(const sync::LookupOptions& options);
 Result<stats::TableFormat> TableFormatFlag(const std::string& text);
 
 /// --calibration (-c), bound to `choice`.
-void AddCalibrationFlag(CLI::App& app, CalibrationChoice& choice);
+void AddCalibrationFlag(Command& app, CalibrationChoice& choice);
 /// --rule, --gap-threshold, --max-past-end, --max-bad-lines, bound to `lookup`.
-void AddLookupFlags(CLI::App& app, LookupChoice& lookup);
+void AddLookupFlags(Command& app, LookupChoice& lookup);
 /// The clip analysis' flags (`video`, `sync --video`): regions, foot, scale, threshold and
 /// exposure, bound to `clip`; returned so a mode flag can require or exclude them.
-std::vector<CLI::Option*> AddClipFlags(CLI::App& app, ClipChoice& clip);
+std::vector<Flag*> AddClipFlags(Command& app, ClipChoice& clip);
 
 /// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);

@@ -48,34 +48,34 @@ int RunEmulate(const EmulateCommand& command, std::ostream& out, std::ostream& e
   return kExitOk;
 }
 
-Subcommand AddEmulateCommand(CLI::App& parent) {
+Subcommand AddEmulateCommand(Command& parent) {
   auto command = std::make_shared<EmulateCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "emulate", "A test controller on a pseudo-terminal (prints its path), with fault injection");
-  app->add_option("--rate", command->rate_hz, "Sample frames per second")->capture_default_str();
-  app->add_flag("--unpaced", command->unpaced, "Send as fast as the reader takes frames");
-  app->add_flag("--autostart", command->autostart, "Start the test without a START command");
+  app->AddOption("--rate", command->rate_hz, "Sample frames per second")->ShowDefault();
+  app->AddSwitch("--unpaced", command->unpaced, "Send as fast as the reader takes frames");
+  app->AddSwitch("--autostart", command->autostart, "Start the test without a START command");
   AddTestFlags(*app, command->test);
-  app->add_option("--link", command->link_path,
+  app->AddOption("--link", command->link_path,
                   "Stable symlink to the pseudo-terminal (kept across disconnects)");
-  app->add_option("--corrupt", command->corrupt_probability,
+  app->AddOption("--corrupt", command->corrupt_probability,
                   "Probability that a byte gets a bit flipped")
-      ->capture_default_str();
-  app->add_option("--drop", command->drop_probability, "Probability that a frame is dropped")
-      ->capture_default_str();
-  app->add_option("--stall-at", command->stall_at_s, "Pause the output at this time, s");
-  app->add_option("--stall-for", command->stall_for_s, "... for this long, s")
-      ->capture_default_str();
-  app->add_option("--disconnect-at", command->disconnect_at_s,
+      ->ShowDefault();
+  app->AddOption("--drop", command->drop_probability, "Probability that a frame is dropped")
+      ->ShowDefault();
+  app->AddOption("--stall-at", command->stall_at_s, "Pause the output at this time, s");
+  app->AddOption("--stall-for", command->stall_for_s, "... for this long, s")
+      ->ShowDefault();
+  app->AddOption("--disconnect-at", command->disconnect_at_s,
                   "Unplug at this time, s (needs --link)");
-  app->add_option("--disconnect-for", command->disconnect_for_s, "... for this long, s")
-      ->capture_default_str();
-  app->add_option("--drift-ppm", command->drift_ppm, "Device clock rate error, ppm")
-      ->capture_default_str();
-  app->add_option("--seed", command->seed, "Seed of the fault generator")->capture_default_str();
-  app->add_option("--duration", command->duration_s, "Run this long, s (0: until done)")
-      ->capture_default_str();
-  app->add_flag("--keep-running", command->keep_running,
+  app->AddOption("--disconnect-for", command->disconnect_for_s, "... for this long, s")
+      ->ShowDefault();
+  app->AddOption("--drift-ppm", command->drift_ppm, "Device clock rate error, ppm")
+      ->ShowDefault();
+  app->AddOption("--seed", command->seed, "Seed of the fault generator")->ShowDefault();
+  app->AddOption("--duration", command->duration_s, "Run this long, s (0: until done)")
+      ->ShowDefault();
+  app->AddSwitch("--keep-running", command->keep_running,
                 "Keep running after the test ends (until Ctrl-C or --duration)");
   return RunsWith(app, command, RunEmulate);
 }

@@ -38,14 +38,14 @@ int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostr
   return kExitOk;
 }
 
-Subcommand AddImport2018Command(CLI::App& parent) {
+Subcommand AddImport2018Command(Command& parent) {
   auto command = std::make_shared<Import2018Command>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "import-2018", "Turn a 2018 Laika folder (logs + video times CSV) into a trial manifest");
-  app->add_option("folder", command->folder, "Folder with TestN*.txt and the times CSV")
-      ->required();
-  app->add_option("--output,-o", command->output_path, "Manifest to write")->required();
-  app->add_flag("--force", command->force, "Overwrite an existing manifest");
+  app->AddOption("folder", command->folder, "Folder with TestN*.txt and the times CSV")
+      ->Required();
+  app->AddOption("--output,-o", command->output_path, "Manifest to write")->Required();
+  app->AddSwitch("--force", command->force, "Overwrite an existing manifest");
   return RunsWith(app, command, RunImport2018);
 }
 

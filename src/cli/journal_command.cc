@@ -47,17 +47,17 @@ int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& e
   return kExitOk;
 }
 
-Subcommand AddJournalCommand(CLI::App& parent) {
+Subcommand AddJournalCommand(Command& parent) {
   auto command = std::make_shared<JournalCommand>();
-  CLI::App* app =
-      parent.add_subcommand("journal", "Show a capture journal, or rebuild its controller log");
-  app->add_option("journal", command->journal_path, "Capture journal")->required();
-  app->add_flag("--replay", command->replay,
+  Command* app =
+      parent.AddSubcommand("journal", "Show a capture journal, or rebuild its controller log");
+  app->AddOption("journal", command->journal_path, "Capture journal")->Required();
+  app->AddSwitch("--replay", command->replay,
                 "Rebuild the controller log with live capture's parsing");
-  app->add_option("--output,-o", command->output_path, "With --replay: log to write");
-  app->add_flag("--force", command->force, "Overwrite an existing output file");
-  app->add_flag("--hex", command->hex, "Dump bytes as hexadecimal");
-  app->add_option("--max-records", command->max_records, "Dump at most this many records");
+  app->AddOption("--output,-o", command->output_path, "With --replay: log to write");
+  app->AddSwitch("--force", command->force, "Overwrite an existing output file");
+  app->AddSwitch("--hex", command->hex, "Dump bytes as hexadecimal");
+  app->AddOption("--max-records", command->max_records, "Dump at most this many records");
   AddCalibrationFlag(*app, command->calibration);
   return RunsWith(app, command, RunJournal);
 }

@@ -137,20 +137,20 @@ int RunLog(const LogCommand& command, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
-Subcommand AddLogCommand(CLI::App& parent) {
+Subcommand AddLogCommand(Command& parent) {
   auto command = std::make_shared<LogCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "log", "What a controller log holds; optionally convert it to liftoff's format");
-  app->add_option("log", command->log_path, "Controller log")->required();
-  app->add_option("--log-format", command->log_format, "auto, liftoff or laika-2018")
-      ->capture_default_str();
+  app->AddOption("log", command->log_path, "Controller log")->Required();
+  app->AddOption("--log-format", command->log_format, "auto, liftoff or laika-2018")
+      ->ShowDefault();
   AddCalibrationFlag(*app, command->calibration);
-  app->add_option("--max-bad-lines", command->max_bad_lines, "Malformed lines to skip (reported)")
-      ->capture_default_str();
-  app->add_option("--gap-threshold", command->gap_threshold_s, "Gap threshold, seconds")
-      ->capture_default_str();
-  app->add_option("--convert", command->convert_path, "Write the log in liftoff's format here");
-  app->add_flag("--json", command->json, "JSON output");
+  app->AddOption("--max-bad-lines", command->max_bad_lines, "Malformed lines to skip (reported)")
+      ->ShowDefault();
+  app->AddOption("--gap-threshold", command->gap_threshold_s, "Gap threshold, seconds")
+      ->ShowDefault();
+  app->AddOption("--convert", command->convert_path, "Write the log in liftoff's format here");
+  app->AddSwitch("--json", command->json, "JSON output");
   return RunsWith(app, command, RunLog);
 }
 

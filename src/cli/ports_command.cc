@@ -16,9 +16,9 @@ int RunPorts(const PortsCommand&, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
-Subcommand AddPortsCommand(CLI::App& parent) {
+Subcommand AddPortsCommand(Command& parent) {
   auto command = std::make_shared<PortsCommand>();
-  CLI::App* app = parent.add_subcommand("ports", "List the serial ports of this machine");
+  Command* app = parent.AddSubcommand("ports", "List the serial ports of this machine");
   return RunsWith(app, command, RunPorts);
 }
 

@@ -497,48 +497,48 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
 // ---------------------------------------------------------------------------------------
 // the flags
 
-Subcommand AddReportCommand(CLI::App& parent) {
+Subcommand AddReportCommand(Command& parent) {
   auto command = std::make_shared<ReportCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "report",
       "The campaign in one folder: every trial, the simulated column (cached), the tables, the "
       "figures (gnuplot), report.md and report.html");
-  app->add_option("manifest", command->manifest_path,
+  app->AddOption("manifest", command->manifest_path,
                   "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
-      ->required();
-  app->add_option("--output,-o", command->output_dir, "Folder to write the report in")
-      ->required();
+      ->Required();
+  app->AddOption("--output,-o", command->output_dir, "Folder to write the report in")
+      ->Required();
   AddCalibrationFlag(*app, command->calibration);
   AddLookupFlags(*app, command->lookup);
-  app->add_flag("--no-sim", command->no_sim, "Leave the simulation out");
-  app->add_option("--cache-dir", command->cache_dir,
+  app->AddSwitch("--no-sim", command->no_sim, "Leave the simulation out");
+  app->AddOption("--cache-dir", command->cache_dir,
                   "Cached sweeps (<key>.json) here (default: DIR/sim-cache)");
-  app->add_option("--gnuplot", command->gnuplot, "The gnuplot program")->capture_default_str();
+  app->AddOption("--gnuplot", command->gnuplot, "The gnuplot program")->ShowDefault();
   AddSweepFlags(*app, command->sweep);
   AddExperimentFlags(*app, command->sweep.experiment);  // its --progress is the report's too
-  app->add_option("--fit-min", command->fit.sigma_min, "Tension scale fitted from (sigma)")
-      ->capture_default_str();
-  app->add_option("--fit-max", command->fit.sigma_max, "... to (sigma)")->capture_default_str();
-  app->add_option("--fit-step", command->fit.sigma_step, "Simulated every (sigma)")
-      ->capture_default_str();
-  app->add_option("--bootstrap", command->fit.bootstrap_samples, "Bootstrap resamples of the fit")
-      ->capture_default_str();
-  app->add_option("--mc-samples", command->monte_carlo.samples,
+  app->AddOption("--fit-min", command->fit.sigma_min, "Tension scale fitted from (sigma)")
+      ->ShowDefault();
+  app->AddOption("--fit-max", command->fit.sigma_max, "... to (sigma)")->ShowDefault();
+  app->AddOption("--fit-step", command->fit.sigma_step, "Simulated every (sigma)")
+      ->ShowDefault();
+  app->AddOption("--bootstrap", command->fit.bootstrap_samples, "Bootstrap resamples of the fit")
+      ->ShowDefault();
+  app->AddOption("--mc-samples", command->monte_carlo.samples,
                   "Monte Carlo draws of the spring constants (0: none)")
-      ->capture_default_str();
-  app->add_option("--mc-seed", command->monte_carlo.seed, "Monte Carlo seed")->capture_default_str();
-  app->add_option("--mc-sd-scale", command->monte_carlo.stddev_scale,
+      ->ShowDefault();
+  app->AddOption("--mc-seed", command->monte_carlo.seed, "Monte Carlo seed")->ShowDefault();
+  app->AddOption("--mc-sd-scale", command->monte_carlo.stddev_scale,
                   "Monte Carlo: Table I's standard deviations times this")
-      ->capture_default_str();
-  app->add_option("--jobs,-j", command->jobs,
+      ->ShowDefault();
+  app->AddOption("--jobs,-j", command->jobs,
                   "Trials analysed at once (0: the machine's cores; same results for any)")
-      ->capture_default_str();
-  app->add_option("--shard", command->shard,
+      ->ShowDefault();
+  app->AddOption("--shard", command->shard,
                   "i/n: analyse shard i of n (trials and Monte Carlo draws) and write "
                   "DIR/shard-i-of-n.json instead of the report (docs/cluster.md)");
-  app->add_option("--merge", command->merge,
+  app->AddOption("--merge", command->merge,
                   "Shard files (every shard of one run) merged into the report")
-      ->expected(1, -1);
+      ->OneOrMore();
   return RunsWith(app, command, RunReport);
 }
 

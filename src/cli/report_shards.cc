@@ -414,7 +414,8 @@ Result<LoadedShard> LoadShard(const fs::path& path, const std::string& fingerpri
   };
   LoadedShard loaded{path, {}, {}};
   try {
-    if (!document.is_object() || document.value("format", "") != kShardFormat) {
+    if (!document.is_object() || !document.contains("format") ||
+        document.at("format") != std::string(kShardFormat)) {
       return bad("not a liftoff report shard (expected format \"" + std::string(kShardFormat) +
                  "\")");
     }

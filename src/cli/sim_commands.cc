@@ -384,12 +384,12 @@ const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags() {
   return flags;
 }
 
-void AddExperimentFlags(CLI::App& app, SimExperimentChoice& choice) {
-  app.add_option("--model", choice.model_path,
+void AddExperimentFlags(Command& app, SimExperimentChoice& choice) {
+  app.AddOption("--model", choice.model_path,
                  "Model JSON (default: the bundled samples/models/laika.json)");
   AddFlags(app, ExperimentFlags(), choice.options);
-  app.add_option("--progress", choice.progress, "Progress on stderr: auto, live, lines or off")
-      ->capture_default_str();
+  app.AddOption("--progress", choice.progress, "Progress on stderr: auto, live, lines or off")
+      ->ShowDefault();
 }
 
 const std::vector<FieldFlag<sim::MjcfOptions>>& MjcfFlags() {
@@ -699,65 +699,64 @@ int RunSimExportMjcf(const SimExportMjcfCommand& command, std::ostream& out, std
 // ---------------------------------------------------------------------------------------
 // the flags of the three
 
-Subcommand AddSimRunCommand(CLI::App& sim) {
+Subcommand AddSimRunCommand(Command& sim) {
   auto command = std::make_shared<SimRunCommand>();
-  CLI::App* app = sim.add_subcommand(
+  Command* app = sim.AddSubcommand(
       "run", "One simulated test: each foot's liftoff rotation, optionally the height curves");
-  app->add_option("--foot", command->foot, "Foot the test targets: A, B, C or D")
-      ->capture_default_str();
-  app->add_option("--tension", command->tension,
+  app->AddOption("--foot", command->foot, "Foot the test targets: A, B, C or D")
+      ->ShowDefault();
+  app->AddOption("--tension", command->tension,
                   "Tension point: low, med-low, mean, med-high, high or 0..4")
-      ->capture_default_str();
-  app->add_option("--stiffness", command->stiffness_n_per_m,
+      ->ShowDefault();
+  app->AddOption("--stiffness", command->stiffness_n_per_m,
                   "Explicit stiffnesses SILICONE,BUNA_N,SPRING in N/m (instead of --tension)")
-      ->delimiter(',')
-      ->allow_extra_args(false);
+      ->CommaSeparated();
   AddExperimentFlags(*app, command->experiment);
-  app->add_flag("--json", command->json, "JSON output");
-  app->add_option("--curves", command->curves_path,
+  app->AddSwitch("--json", command->json, "JSON output");
+  app->AddOption("--curves", command->curves_path,
                   "Write the foot-height curves (CSV) here; - for stdout");
   return RunsWith(app, command, RunSimRun);
 }
 
-Subcommand AddSimSweepCommand(CLI::App& sim) {
+Subcommand AddSimSweepCommand(Command& sim) {
   auto command = std::make_shared<SimSweepCommand>();
-  CLI::App* app = sim.add_subcommand(
+  Command* app = sim.AddSubcommand(
       "sweep",
       "The tension points x the four foot motions in parallel (paper Table IV's sim columns)");
   AddSweepFlags(*app, *command);
-  app->add_flag("--full-ramp", command->full_ramp,
+  app->AddSwitch("--full-ramp", command->full_ramp,
                 "Run every test to the end of the ramp (same values, slower)");
   AddExperimentFlags(*app, command->experiment);
-  app->add_option("--output,-o", command->output_path,
+  app->AddOption("--output,-o", command->output_path,
                   "Write the simulation results JSON (for liftoff table --sim)");
-  app->add_flag("--json", command->json, "Print the results JSON instead of the table");
-  app->add_option("--hardware", command->hardware_path,
+  app->AddSwitch("--json", command->json, "Print the results JSON instead of the table");
+  app->AddOption("--hardware", command->hardware_path,
                   "Trial manifest or 2018 Laika folder: also print the hardware-vs-simulation "
                   "table");
-  app->add_option("--format,-f", command->format, "Hardware table format: md, csv, latex or json")
-      ->capture_default_str();
+  app->AddOption("--format,-f", command->format, "Hardware table format: md, csv, latex or json")
+      ->ShowDefault();
   AddCalibrationFlag(*app, command->calibration);
   AddLookupFlags(*app, command->lookup);
   return RunsWith(app, command, RunSimSweep);
 }
 
-void AddSweepFlags(CLI::App& app, SimSweepCommand& command) {
+void AddSweepFlags(Command& app, SimSweepCommand& command) {
   AddListOption(app, "--feet", command.feet, "Simulated feet, comma-separated");
   AddListOption(app, "--tensions", command.tensions,
                 "Simulated tension points, comma-separated names or 0..4, or all");
-  app.add_option("--threads", command.threads, "Sweep worker threads (0: all cores)")
-      ->capture_default_str();
+  app.AddOption("--threads", command.threads, "Sweep worker threads (0: all cores)")
+      ->ShowDefault();
 }
 
-Subcommand AddSimExportMjcfCommand(CLI::App& sim) {
+Subcommand AddSimExportMjcfCommand(Command& sim) {
   auto command = std::make_shared<SimExportMjcfCommand>();
-  CLI::App* app = sim.add_subcommand("export-mjcf", "Write the model as a MuJoCo MJCF file");
-  app->add_option("--output,-o", command->output_path, "MJCF file; - for stdout")->required();
-  app->add_option("--foot", command->foot, "The experiment's model for this foot")
-      ->capture_default_str();
-  app->add_option("--tension", command->tension, "... at this tension point")
-      ->capture_default_str();
-  app->add_flag("--as-is", command->as_is,
+  Command* app = sim.AddSubcommand("export-mjcf", "Write the model as a MuJoCo MJCF file");
+  app->AddOption("--output,-o", command->output_path, "MJCF file; - for stdout")->Required();
+  app->AddOption("--foot", command->foot, "The experiment's model for this foot")
+      ->ShowDefault();
+  app->AddOption("--tension", command->tension, "... at this tension point")
+      ->ShowDefault();
+  app->AddSwitch("--as-is", command->as_is,
                 "Export the model file as written (no tension point applied)");
   AddFlags(*app, MjcfFlags(), command->mjcf);
   AddExperimentFlags(*app, command->experiment);

@@ -180,40 +180,40 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
-Subcommand AddSyncCommand(CLI::App& parent) {
+Subcommand AddSyncCommand(Command& parent) {
   auto command = std::make_shared<SyncCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "sync",
       "Rotation at liftoff from one log and the two video instants, given or found in the clip");
-  app->add_option("log", command->log_path, "Controller log")->required();
-  CLI::Option* led_on =
-      app->add_option("--led-on", command->led_on_s, "Video time of the LED switch-on, s");
-  CLI::Option* liftoff =
-      app->add_option("--liftoff", command->liftoff_s, "Video time of the liftoff, s");
-  CLI::Option* uncertainty =
-      app->add_option("--uncertainty", command->uncertainty_s,
+  app->AddOption("log", command->log_path, "Controller log")->Required();
+  Flag* led_on =
+      app->AddOption("--led-on", command->led_on_s, "Video time of the LED switch-on, s");
+  Flag* liftoff =
+      app->AddOption("--liftoff", command->liftoff_s, "Video time of the liftoff, s");
+  Flag* uncertainty =
+      app->AddOption("--uncertainty", command->uncertainty_s,
                       "Timing uncertainty of each instant, s")
-          ->capture_default_str();
-  led_on->needs(liftoff);
-  liftoff->needs(led_on);
-  CLI::Option* video =
-      app->add_option("--video", command->video_path,
+          ->ShowDefault();
+  led_on->Needs(liftoff);
+  liftoff->Needs(led_on);
+  Flag* video =
+      app->AddOption("--video", command->video_path,
                       "Find the two instants in this clip (instead of --led-on and --liftoff)")
-          ->excludes(led_on)
-          ->excludes(liftoff)
-          ->excludes(uncertainty);
-  for (CLI::Option* option : AddClipFlags(*app, command->clip)) option->needs(video);
-  app->add_option("--verify", command->verify_path,
+          ->Excludes(led_on)
+          ->Excludes(liftoff)
+          ->Excludes(uncertainty);
+  for (Flag* option : AddClipFlags(*app, command->clip)) option->Needs(video);
+  app->AddOption("--verify", command->verify_path,
                   "With --video: write a verification image (PNG)")
-      ->needs(video);
-  app->add_option("--progress", command->progress,
+      ->Needs(video);
+  app->AddOption("--progress", command->progress,
                   "With --video: progress on stderr: auto, live, lines or off")
-      ->capture_default_str();
-  app->add_option("--log-format", command->log_format, "auto, liftoff or laika-2018")
-      ->capture_default_str();
+      ->ShowDefault();
+  app->AddOption("--log-format", command->log_format, "auto, liftoff or laika-2018")
+      ->ShowDefault();
   AddCalibrationFlag(*app, command->calibration);
   AddLookupFlags(*app, command->lookup);
-  app->add_flag("--json", command->json, "JSON output");
+  app->AddSwitch("--json", command->json, "JSON output");
   return RunsWith(app, command, RunSync);
 }
 

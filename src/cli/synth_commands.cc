@@ -179,24 +179,24 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
                                   : RunSet(command, *calibration, out, err);
 }
 
-Subcommand AddSynthCommand(CLI::App& parent) {
+Subcommand AddSynthCommand(Command& parent) {
   auto command = std::make_shared<SynthCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "synth",
       "Render synthetic trials (video, controller log, ground truth) from a spec or a set");
-  app->add_option("spec", command->spec_path, "Trial spec JSON (see --print-spec)");
-  app->add_option("--set", command->set_name,
+  app->AddOption("spec", command->spec_path, "Trial spec JSON (see --print-spec)");
+  app->AddOption("--set", command->set_name,
                   "Write a whole named set: ci, paper, ci3d, hard3d or campaign (the 3D camera)");
-  app->add_option("--per-foot", command->campaign_trials_per_foot,
+  app->AddOption("--per-foot", command->campaign_trials_per_foot,
                   "--set campaign: trials per foot (1 .. 20)")
-      ->capture_default_str();
-  app->add_option("--seed", command->seed_offset,
+      ->ShowDefault();
+  app->AddOption("--seed", command->seed_offset,
                   "--set ci3d, hard3d or campaign: every clip's seeds offset by this (0: the "
                   "set as documented; another: its conditions drawn anew)")
-      ->capture_default_str();
-  app->add_option("--output,-o", command->output_dir, "Folder for the files");
-  app->add_flag("--print-spec", command->print_spec, "Print the default spec as JSON");
-  app->add_flag("--quiet,-q", command->quiet, "No progress lines on stderr");
+      ->ShowDefault();
+  app->AddOption("--output,-o", command->output_dir, "Folder for the files");
+  app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");
+  app->AddSwitch("--quiet,-q", command->quiet, "No progress lines on stderr");
   AddCalibrationFlag(*app, command->calibration);
   return RunsWith(app, command, RunSynth);
 }

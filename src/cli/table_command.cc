@@ -254,29 +254,29 @@ int RunTable(const TableCommand& command, std::ostream& out, std::ostream& err) 
   return verified.ok() ? kExitOk : ExitCodeFor(verified.code());
 }
 
-Subcommand AddTableCommand(CLI::App& parent) {
+Subcommand AddTableCommand(Command& parent) {
   auto command = std::make_shared<TableCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "table", "Rotation at liftoff per trial and the per-foot table (paper Table IV layout)");
-  app->add_option("manifest", command->manifest_path,
+  app->AddOption("manifest", command->manifest_path,
                   "Trial manifest (JSON), or a 2018 Laika folder (logs + video times CSV)")
-      ->required();
+      ->Required();
   AddCalibrationFlag(*app, command->calibration);
   AddLookupFlags(*app, command->lookup);
-  app->add_option("--format,-f", command->format, "md, csv, latex or json")->capture_default_str();
-  app->add_option("--tables", command->tables, "both, trials or feet")->capture_default_str();
-  app->add_option("--sim", command->sim_path, "Simulation results JSON for the sim columns");
-  app->add_option("--output,-o", command->output_path, "Write here instead of stdout");
-  app->add_option("--plot", command->plot_path,
+  app->AddOption("--format,-f", command->format, "md, csv, latex or json")->ShowDefault();
+  app->AddOption("--tables", command->tables, "both, trials or feet")->ShowDefault();
+  app->AddOption("--sim", command->sim_path, "Simulation results JSON for the sim columns");
+  app->AddOption("--output,-o", command->output_path, "Write here instead of stdout");
+  app->AddOption("--plot", command->plot_path,
                   "Draw each trial's liftoff rotation beside the simulation with gnuplot: "
                   "FILE.svg and FILE.png, its script FILE.gp and data FILE.dat beside them");
-  app->add_option("--gnuplot", command->gnuplot, "The gnuplot program (for --plot)")
-      ->capture_default_str();
-  app->add_option("--verify-dir", command->verify_dir,
+  app->AddOption("--gnuplot", command->gnuplot, "The gnuplot program (for --plot)")
+      ->ShowDefault();
+  app->AddOption("--verify-dir", command->verify_dir,
                   "Write a verification image per video-analysed trial here (<id>.png)");
-  app->add_option("--progress", command->progress,
+  app->AddOption("--progress", command->progress,
                   "Video analysis progress on stderr: auto, live, lines or off")
-      ->capture_default_str();
+      ->ShowDefault();
   return RunsWith(app, command, RunTable);
 }
 

@@ -311,52 +311,52 @@ TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysi
 // ---------------------------------------------------------------------------------------
 // the flags
 
-std::vector<CLI::Option*> AddClipFlags(CLI::App& app, ClipChoice& clip) {
-  std::vector<CLI::Option*> options;
-  options.push_back(app.add_option("--led-roi", clip.led_roi,
+std::vector<Flag*> AddClipFlags(Command& app, ClipChoice& clip) {
+  std::vector<Flag*> options;
+  options.push_back(app.AddOption("--led-roi", clip.led_roi,
                                    "LED region x,y,w,h in pixels (default: located automatically)"));
-  options.push_back(app.add_option("--foot-roi", clip.foot_roi,
+  options.push_back(app.AddOption("--foot-roi", clip.foot_roi,
                                    "Foot region x,y,w,h in pixels: the foot at rest and room "
                                    "above it (without it: the LED only)"));
-  options.push_back(app.add_option(
+  options.push_back(app.AddOption(
       "--foot", clip.foot, "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
-  options.push_back(app.add_option("--px-per-mm", clip.px_per_mm,
+  options.push_back(app.AddOption("--px-per-mm", clip.px_per_mm,
                                    "Image scale at the foot, px per mm (0: from the foot's width)")
-                        ->capture_default_str());
-  CLI::Option* threshold_mm =
-      app.add_option("--threshold-mm", clip.threshold_mm, "Liftoff threshold above rest, mm")
-          ->capture_default_str();
+                        ->ShowDefault());
+  Flag* threshold_mm =
+      app.AddOption("--threshold-mm", clip.threshold_mm, "Liftoff threshold above rest, mm")
+          ->ShowDefault();
   options.push_back(threshold_mm);
-  options.push_back(app.add_option("--threshold-px", clip.threshold_px,
+  options.push_back(app.AddOption("--threshold-px", clip.threshold_px,
                                    "Liftoff threshold above rest, px, in (0, 1000] (instead "
                                    "of --threshold-mm)")
-                        ->excludes(threshold_mm));
-  options.push_back(app.add_option("--exposure-ms", clip.exposure_ms,
+                        ->Excludes(threshold_mm));
+  options.push_back(app.AddOption("--exposure-ms", clip.exposure_ms,
                                    "Camera exposure per frame, ms, at most the frame interval "
                                    "(0: unknown; the LED then allows any exposure up to the "
                                    "frame interval, the foot takes half the frame interval)")
-                        ->capture_default_str());
+                        ->ShowDefault());
   return options;
 }
 
-Subcommand AddVideoCommand(CLI::App& parent) {
+Subcommand AddVideoCommand(Command& parent) {
   auto command = std::make_shared<VideoCommand>();
-  CLI::App* app = parent.add_subcommand(
+  Command* app = parent.AddSubcommand(
       "video", "Find the LED switch-on and the foot's liftoff in one clip, with proof");
-  app->add_option("clip", command->video_path, "Video file")->required();
+  app->AddOption("clip", command->video_path, "Video file")->Required();
   AddClipFlags(*app, command->clip);
-  app->add_option("--rest-window", command->clip.rest_window,
+  app->AddOption("--rest-window", command->clip.rest_window,
                   "Foot rest window FROM,TO in s from the LED switch-on (write "
                   "--rest-window=-1,0)")
-      ->capture_default_str();
-  app->add_option("--liftoff", command->clip.liftoff, "Liftoff instant: threshold or onset")
-      ->capture_default_str();
-  app->add_option("--verify", command->verify_path, "Write a verification image (PNG)");
-  app->add_option("--annotate", command->annotate_path,
+      ->ShowDefault();
+  app->AddOption("--liftoff", command->clip.liftoff, "Liftoff instant: threshold or onset")
+      ->ShowDefault();
+  app->AddOption("--verify", command->verify_path, "Write a verification image (PNG)");
+  app->AddOption("--annotate", command->annotate_path,
                   "Write the clip with the detections drawn (Motion JPEG AVI)");
-  app->add_flag("--json", command->json, "JSON output");
-  app->add_option("--progress", command->progress, "Progress on stderr: auto, live, lines or off")
-      ->capture_default_str();
+  app->AddSwitch("--json", command->json, "JSON output");
+  app->AddOption("--progress", command->progress, "Progress on stderr: auto, live, lines or off")
+      ->ShowDefault();
   return RunsWith(app, command, RunVideo);
 }
 

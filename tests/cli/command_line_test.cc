@@ -11,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "liftoff/cli/cli11.h"
 #include "liftoff/cli/command_table.h"
 #include "liftoff/cli/sim_commands.h"
 #include "liftoff/cli/video_commands.h"
@@ -39,23 +40,26 @@ std::map<std::string, std::string> CurrentValues(CLI::App* app) {
 }
 
 TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
-  CLI::App shown;
+  CLI::App shown_app;
+  Command shown(&shown_app);
   const std::vector<Subcommand> commands = AddCommands(shown);
   CLI::App reference_app;
-  std::vector<Subcommand> reference = AddCommands(reference_app);
+  Command reference_root(&reference_app);
+  std::vector<Subcommand> reference = AddCommands(reference_root);
   ASSERT_EQ(commands.size(), 15u);
   int checked = 0;
   for (size_t c = 0; c < commands.size(); ++c) {
-    const std::map<std::string, std::string> defaults = CurrentValues(reference[c].app);
-    for (const CLI::Option* option : commands[c].app->get_options()) {
+    const std::map<std::string, std::string> defaults = CurrentValues(reference[c].app->app());
+    for (const CLI::Option* option : commands[c].app->app()->get_options()) {
       const std::string& help_default = option->get_default_str();
       if (!option->nonpositional() || help_default.empty()) continue;
       const std::string name = option->get_name();
       EXPECT_EQ(help_default, defaults.at(name)) << name;
       // the shown default, given on the command line, leaves every field as it was
       CLI::App given_app;
-      std::vector<Subcommand> given = AddCommands(given_app);
-      std::vector<std::string> arguments = CommandPath(given[c].app);
+      Command given_root(&given_app);
+      std::vector<Subcommand> given = AddCommands(given_root);
+      std::vector<std::string> arguments = CommandPath(given[c].app->app());
       arguments.push_back(name + "=" + help_default);
       std::reverse(arguments.begin(), arguments.end());  // CLI11 takes them last first
       try {
@@ -63,7 +67,7 @@ TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
       } catch (const CLI::RequiredError&) {
         // the command's positional arguments: the flags are read before that check
       }
-      EXPECT_EQ(CurrentValues(given[c].app), defaults) << name << "=" << help_default;
+      EXPECT_EQ(CurrentValues(given[c].app->app()), defaults) << name << "=" << help_default;
       ++checked;
     }
   }
@@ -72,10 +76,11 @@ TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
 
 TEST(CommandLine, NoHelpTextTypesInANumericDefault) {
   CLI::App app;
-  const std::vector<Subcommand> commands = AddCommands(app);
+  Command root(&app);
+  const std::vector<Subcommand> commands = AddCommands(root);
   const std::regex typed_in(R"(default:? -?[0-9])");
   for (const Subcommand& command : commands) {
-    for (const CLI::Option* option : command.app->get_options()) {
+    for (const CLI::Option* option : command.app->app()->get_options()) {
       EXPECT_FALSE(std::regex_search(option->get_description(), typed_in))
           << option->get_name() << ": " << option->get_description();
     }
@@ -84,7 +89,8 @@ TEST(CommandLine, NoHelpTextTypesInANumericDefault) {
 
 TEST(CommandLine, ExperimentFlagsShowTheExperimentsDefaultsInTheirUnits) {
   CLI::App app;
-  const std::vector<Subcommand> commands = AddCommands(app);
+  Command root(&app);
+  const std::vector<Subcommand> commands = AddCommands(root);
   const CLI::App* run = app.get_subcommand("sim")->get_subcommand("run");
   const sim::ExperimentOptions defaults;
   auto shown = [&](const std::string& flag) { return run->get_option(flag)->get_default_str(); };

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/cli11.h"
 #include "liftoff/cli/sim_commands.h"
 #include "liftoff/core/json.h"
 #include "liftoff/stats/sim_results.h"
@@ -376,7 +377,8 @@ TEST(SimResultsFromSweep, RoundTripsThroughLoadSimResults) {
 TEST(ExperimentFlags, ConvertUnitsAndDescribeWhatDiffersFromTheDefaults) {
   SimExperimentChoice choice;
   CLI::App app;
-  AddExperimentFlags(app, choice);
+  Command root(&app);
+  AddExperimentFlags(root, choice);
   EXPECT_EQ(DescribeOverrides(choice), "");
   app.parse(
       "--ramp-deg 30 --threshold-mm 2 --ground-clearance-mm 0.5 --rotation=- --friction 0.25 "

@@ -111,9 +111,9 @@ struct JournalCommand {
 int RunJournal(const JournalCommand& command, std::ostream& out, std::ostream& err);
 
 /// Each command above added to the command line `parent` (flags bound to its struct).
-Subcommand AddCaptureCommand(CLI::App& parent);
-Subcommand AddEmulateCommand(CLI::App& parent);
-Subcommand AddPortsCommand(CLI::App& parent);
-Subcommand AddJournalCommand(CLI::App& parent);
+Subcommand AddCaptureCommand(Command& parent);
+Subcommand AddEmulateCommand(Command& parent);
+Subcommand AddPortsCommand(Command& parent);
+Subcommand AddJournalCommand(Command& parent);
 
 }  // namespace liftoff::cli

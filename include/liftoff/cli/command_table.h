@@ -3,9 +3,8 @@
 // default).
 #pragma once
 
+#include <ostream>
 #include <vector>
-
-#include "liftoff/cli/cli11.h"
 
 #include "liftoff/cli/flags.h"
 
@@ -13,6 +12,9 @@ namespace liftoff::cli {
 
 /// Adds every command to `app` (`sim` with its three subcommands), each bound to a fresh
 /// command struct; the Subcommands run them once `app` has parsed.
-std::vector<Subcommand> AddCommands(CLI::App& app);
+std::vector<Subcommand> AddCommands(Command& app);
+
+/// The liftoff command line: parses `argv`, runs the command chosen, returns its exit code.
+int RunLiftoff(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace liftoff::cli

@@ -163,10 +163,10 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err);
 
 /// Each command above added to the command line `parent`: its flags bound to a command
 /// struct of its own (defaults: the struct's), run by the returned Subcommand.
-Subcommand AddTableCommand(CLI::App& parent);
-Subcommand AddImport2018Command(CLI::App& parent);
-Subcommand AddSyncCommand(CLI::App& parent);
-Subcommand AddLogCommand(CLI::App& parent);
-Subcommand AddCalibCommand(CLI::App& parent);
+Subcommand AddTableCommand(Command& parent);
+Subcommand AddImport2018Command(Command& parent);
+Subcommand AddSyncCommand(Command& parent);
+Subcommand AddLogCommand(Command& parent);
+Subcommand AddCalibCommand(Command& parent);
 
 }  // namespace liftoff::cli

@@ -5,6 +5,10 @@
 // flag would be given (DescribeChanged), and names the flag in the struct's Validate()
 // messages (NameFlagIn). Validate() stays the only range check.
 //
+// CLI11 stays behind Command and Flag: only src/cli/flags.cc includes it, so the command
+// files do not each compile the parser's templates again (a build-time cost, not a style
+// rule: CLI11 2.1 is header-only).
+//
 //   using O = sim::ExperimentOptions;
 //   NumberFlag<O>("--threshold-mm", LIFTOFF_FIELD(liftoff_threshold_m), kMillimetresForMetres,
 //                 "Liftoff: height above the reference, mm"),
@@ -15,29 +19,97 @@
 #include <numbers>
 #include <optional>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
-#include "liftoff/cli/cli11.h"
-
 #include "liftoff/core/json.h"
 #include "liftoff/core/status.h"
+
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace liftoff::cli {
 
 /// A bad value for a flag that no option struct can hold (a word outside the flag's
 /// choices, a list of the wrong length), thrown while parsing: RunCommandLine reports its
 /// status like a Run function's failure (the class's exit code, docs/cli.md).
-class FlagError : public CLI::ParseError {
+class FlagError : public std::runtime_error {
  public:
   explicit FlagError(Status status);
   const Status& status() const { return status_; }
 
  private:
   Status status_;
+};
+
+/// One flag or positional argument of a Command (a CLI11 option). Its methods return
+/// the flag itself, to chain: app->AddOption(...)->Required().
+class Flag {
+ public:
+  explicit Flag(CLI::Option* option) : option_(option) {}
+  /// The command line must give it.
+  Flag* Required();
+  /// Help shows the bound field's value at this moment (the struct's default).
+  Flag* ShowDefault();
+  /// Help shows `text()` now (the bound field's value, as the flag would write it).
+  Flag* ShowDefaultFrom(std::function<std::string()> text);
+  /// Given only together with `other`.
+  Flag* Needs(Flag* other);
+  /// Never given together with `other`.
+  Flag* Excludes(Flag* other);
+  /// The value's name in help ("A|B").
+  Flag* TypeName(const std::string& name);
+  /// A list in one argument, comma-separated ("1,2,3").
+  Flag* CommaSeparated();
+  /// A positional argument taking every remaining argument (one at least).
+  Flag* OneOrMore();
+  CLI::Option* option() const { return option_; }
+
+ private:
+  CLI::Option* option_;
+};
+
+/// A command of the command line (a CLI11 app): its flags and subcommands, owned here.
+/// `Value` of AddOption and AddOptionFunction is one of the types src/cli/flags.cc
+/// instantiates (std::string, std::filesystem::path, double, int, int64_t, uint64_t and
+/// the std::optional and std::vector forms it lists); another is a link error.
+class Command {
+ public:
+  /// Wraps `app` (not owned; it must outlive this).
+  explicit Command(CLI::App* app);
+  ~Command();
+  Command(const Command&) = delete;
+  Command& operator=(const Command&) = delete;
+
+  /// A subcommand, owned by this command.
+  Command* AddSubcommand(const std::string& name, const std::string& help);
+  /// One subcommand must be given.
+  void RequireSubcommand();
+  /// A flag ("--name,-n") or positional ("name") writing `field` (which must outlive this).
+  template <typename Value>
+  Flag* AddOption(const std::string& name, Value& field, const std::string& help);
+  /// A flag calling `parse` with its value.
+  template <typename Value>
+  Flag* AddOptionFunction(const std::string& name, std::function<void(const Value&)> parse,
+                          const std::string& help);
+  /// A flag without a value: given means true.
+  Flag* AddSwitch(const std::string& name, bool& field, const std::string& help);
+  /// Whether the command line chose this command.
+  bool Parsed() const;
+  CLI::App* app() const { return app_; }
+
+ private:
+  Flag* Keep(CLI::Option* option);
+
+  CLI::App* app_;
+  std::vector<std::unique_ptr<Command>> subcommands_;
+  std::vector<std::unique_ptr<Flag>> flags_;
 };
 
 /// `parts` with `separator` between them: Join({"A", "C"}, ",") is "A,C".
@@ -66,7 +138,7 @@ struct FieldFlag {
   /// A flag without a value (given: on).
   bool is_switch = false;
   /// Adds the flag to `app`, bound to the field of `options` (which must outlive `app`).
-  std::function<CLI::Option*(CLI::App& app, Options& options)> add;
+  std::function<Flag*(Command& app, Options& options)> add;
   /// The field's value as the flag writes it; empty when unset (an empty optional).
   std::function<std::string(const Options& options)> text;
 };
@@ -107,9 +179,9 @@ FieldFlag<Options> NumberFlag(std::string flag, std::string field, Access access
       return FormatNumber(value * unit.flag_per_field);
     }
   };
-  bound.add = [flag, help, access, unit, text = bound.text](CLI::App& app, Options& options) {
+  bound.add = [flag, help, access, unit, text = bound.text](Command& app, Options& options) {
     Field& target = access(options);
-    CLI::Option* option = app.add_option_function<Value>(
+    Flag* option = app.AddOptionFunction<Value>(
         flag,
         [&target, unit](const Value& value) {
           if constexpr (std::is_integral_v<Value>) {
@@ -119,8 +191,7 @@ FieldFlag<Options> NumberFlag(std::string flag, std::string field, Access access
           }
         },
         help);
-    return option->default_function([&options, text] { return text(options); })
-        ->capture_default_str();
+    return option->ShowDefaultFrom([&options, text] { return text(options); });
   };
   return bound;
 }
@@ -144,9 +215,9 @@ FieldFlag<Options> ChoiceFlagOf(std::string flag, std::string field,
     }
     return "";
   };
-  bound.add = [flag, help, words, names, set, text = bound.text](CLI::App& app,
+  bound.add = [flag, help, words, names, set, text = bound.text](Command& app,
                                                                  Options& options) {
-    CLI::Option* option = app.add_option_function<std::string>(
+    Flag* option = app.AddOptionFunction<std::string>(
         flag,
         [flag, words, names, set, &options](const std::string& given) {
           for (const auto& [name, meaning] : words) {
@@ -156,9 +227,8 @@ FieldFlag<Options> ChoiceFlagOf(std::string flag, std::string field,
                                                given + "\""));
         },
         help);
-    return option->type_name(Join(names, "|"))
-        ->default_function([&options, text] { return text(options); })
-        ->capture_default_str();
+    return option->TypeName(Join(names, "|"))
+        ->ShowDefaultFrom([&options, text] { return text(options); });
   };
   return bound;
 }
@@ -183,8 +253,8 @@ FieldFlag<Options> SwitchFlag(std::string flag, std::string field, Access access
   bound.text = [access](const Options& options) -> std::string {
     return access(options) ? "true" : "";
   };
-  bound.add = [flag, help, access](CLI::App& app, Options& options) {
-    return app.add_flag(flag, access(options), help);
+  bound.add = [flag, help, access](Command& app, Options& options) {
+    return app.AddSwitch(flag, access(options), help);
   };
   return bound;
 }
@@ -202,9 +272,9 @@ FieldFlag<Options> NumbersFlag(std::string flag, std::string field, size_t count
     for (double value : get(options)) joined += (joined.empty() ? "" : ",") + FormatNumber(value);
     return joined;
   };
-  bound.add = [flag, count, set, expected, help, text = bound.text](CLI::App& app,
+  bound.add = [flag, count, set, expected, help, text = bound.text](Command& app,
                                                                     Options& options) {
-    CLI::Option* option = app.add_option_function<std::vector<double>>(
+    Flag* option = app.AddOptionFunction<std::vector<double>>(
         flag,
         [flag, count, set, expected, &options](const std::vector<double>& values) {
           if (values.size() != count) {
@@ -214,17 +284,14 @@ FieldFlag<Options> NumbersFlag(std::string flag, std::string field, size_t count
           set(options, values);
         },
         help);
-    return option->delimiter(',')
-        ->allow_extra_args(false)
-        ->default_function([&options, text] { return text(options); })
-        ->capture_default_str();
+    return option->CommaSeparated()->ShowDefaultFrom([&options, text] { return text(options); });
   };
   return bound;
 }
 
 /// Adds every flag of `flags` to `app`, bound to `options` (which must outlive `app`).
 template <typename Options>
-void AddFlags(CLI::App& app, const std::vector<FieldFlag<Options>>& flags, Options& options) {
+void AddFlags(Command& app, const std::vector<FieldFlag<Options>>& flags, Options& options) {
   for (const FieldFlag<Options>& flag : flags) flag.add(app, options);
 }
 
@@ -268,29 +335,34 @@ Status NameFlagIn(const Status& status, const std::vector<FieldFlag<Options>>& f
 
 /// A comma-separated list flag ("--feet A,C") bound to `field`; its help shows the
 /// field's value.
-CLI::Option* AddListOption(CLI::App& app, const std::string& flag, std::vector<std::string>& field,
-                           const std::string& help);
+Flag* AddListOption(Command& app, const std::string& flag, std::vector<std::string>& field,
+                    const std::string& help);
 
 /// A subcommand on the command line: its CLI11 command (flags bound to its command struct)
 /// and the function that runs that struct once parsed.
 struct Subcommand {
-  CLI::App* app = nullptr;
+  Command* app = nullptr;
   std::function<int(std::ostream& out, std::ostream& err)> run;
 };
 
 /// The Subcommand that runs `run` with `command` (the struct `app`'s flags are bound to).
-template <typename Command>
-Subcommand RunsWith(CLI::App* app, std::shared_ptr<Command> command,
-                    int (*run)(const Command&, std::ostream&, std::ostream&)) {
+template <typename Parsed>
+Subcommand RunsWith(Command* app, std::shared_ptr<Parsed> command,
+                    int (*run)(const Parsed&, std::ostream&, std::ostream&)) {
   return {app, [command = std::move(command), run](std::ostream& out, std::ostream& err) {
             return run(*command, out, err);
           }};
 }
 
-/// Parses `argv` with `app` and runs the subcommand chosen among `commands`. Exit codes:
-/// the Run function's; usage errors kExitUsage; a FlagError its status' class; an
-/// exception kExitInternal (docs/cli.md).
-int RunCommandLine(CLI::App& app, const std::vector<Subcommand>& commands, int argc,
-                   const char* const* argv, std::ostream& out, std::ostream& err);
+/// The commands `add_commands` puts under a root command.
+using CommandTable = std::function<std::vector<Subcommand>(Command& root)>;
+
+/// Parses `argv` with a root command (`description` in its help, `version` printed by
+/// --version) holding `commands`, and runs the subcommand chosen. Exit codes: the Run
+/// function's; usage errors kExitUsage; a FlagError its status' class; an exception
+/// kExitInternal (docs/cli.md).
+int RunCommandLine(const std::string& description, const std::string& version,
+                   const CommandTable& commands, int argc, const char* const* argv,
+                   std::ostream& out, std::ostream& err);
 
 }  // namespace liftoff::cli

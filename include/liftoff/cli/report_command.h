@@ -59,6 +59,6 @@ struct ReportCommand {
 int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err);
 
 /// The command added to the command line `parent` (flags bound to its struct).
-Subcommand AddReportCommand(CLI::App& parent);
+Subcommand AddReportCommand(Command& parent);
 
 }  // namespace liftoff::cli

@@ -39,7 +39,7 @@ struct SimExperimentChoice {
 const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags();
 
 /// Adds --model, ExperimentFlags() and --progress to `app`, bound to `choice`.
-void AddExperimentFlags(CLI::App& app, SimExperimentChoice& choice);
+void AddExperimentFlags(Command& app, SimExperimentChoice& choice);
 
 /// The choice's experiment options once Validate() accepts them; kInvalidArgument naming
 /// the flag otherwise: "--ramp-s: expected a number in (0, 3600], got 0".
@@ -133,10 +133,10 @@ stats::SimResults SimResultsFromSweep(const sim::SweepResult& sweep, std::string
 
 /// The three subcommands of `liftoff sim`, added to the `sim` command: flags bound to
 /// their command structs.
-Subcommand AddSimRunCommand(CLI::App& sim);
-Subcommand AddSimSweepCommand(CLI::App& sim);
-Subcommand AddSimExportMjcfCommand(CLI::App& sim);
+Subcommand AddSimRunCommand(Command& sim);
+Subcommand AddSimSweepCommand(Command& sim);
+Subcommand AddSimExportMjcfCommand(Command& sim);
 /// --feet, --tensions and --threads of the sweep (`sim sweep`, `report`).
-void AddSweepFlags(CLI::App& app, SimSweepCommand& command);
+void AddSweepFlags(Command& app, SimSweepCommand& command);
 
 }  // namespace liftoff::cli

@@ -36,6 +36,6 @@ struct SynthCommand {
 int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err);
 
 /// The command added to the command line `parent` (flags bound to its struct).
-Subcommand AddSynthCommand(CLI::App& parent);
+Subcommand AddSynthCommand(Command& parent);
 
 }  // namespace liftoff::cli

@@ -90,6 +90,6 @@ TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysi
                                            const std::filesystem::path& dir, std::ostream& err);
 
 /// The command added to the command line `parent` (flags bound to its struct).
-Subcommand AddVideoCommand(CLI::App& parent);
+Subcommand AddVideoCommand(Command& parent);
 
 }  // namespace liftoff::cli
