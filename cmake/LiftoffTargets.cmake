@@ -38,7 +38,8 @@ endfunction()
 # Tests sharing a RESOURCE_LOCK never run at the same time under `ctest -j`
 # (pseudo-terminal numbers are reused across processes); FIXTURE names a CTest fixture
 # every test of the executable requires (its setup runs once per ctest run). ONE_PROCESS
-# registers the executable as one ctest test instead of one per GoogleTest test.
+# registers the executable as one ctest test instead of one per GoogleTest test (a
+# GTEST_SKIP inside it then shows as passed).
 function(liftoff_add_test name)
   cmake_parse_arguments(ARG "ONE_PROCESS" "RESOURCE_LOCK;FIXTURE" "SOURCES;DEPS" ${ARGN})
   set(extra_properties "")

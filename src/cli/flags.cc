@@ -92,7 +92,7 @@ Flag* Command::Keep(CLI::Option* option) {
   return flags_.back().get();
 }
 
-// the value types the command files bind
+// the value types the command files bind: AddOption ...
 template Flag* Command::AddOption(const std::string&, std::string&, const std::string&);
 template Flag* Command::AddOption(const std::string&, double&, const std::string&);
 template Flag* Command::AddOption(const std::string&, int&, const std::string&);
@@ -105,6 +105,7 @@ template Flag* Command::AddOption(const std::string&, std::filesystem::path&, co
 template Flag* Command::AddOption(const std::string&, std::vector<std::filesystem::path>&,
                                   const std::string&);
 template Flag* Command::AddOption(const std::string&, std::vector<double>&, const std::string&);
+// ... and AddOptionFunction
 template Flag* Command::AddOptionFunction(const std::string&,
                                           std::function<void(const std::string&)>,
                                           const std::string&);

@@ -49,8 +49,8 @@ TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
   ASSERT_EQ(commands.size(), 15u);
   int checked = 0;
   for (size_t c = 0; c < commands.size(); ++c) {
-    const std::map<std::string, std::string> defaults = CurrentValues(reference[c].app->app());
-    for (const CLI::Option* option : commands[c].app->app()->get_options()) {
+    const std::map<std::string, std::string> defaults = CurrentValues(reference[c].app->cli_app());
+    for (const CLI::Option* option : commands[c].app->cli_app()->get_options()) {
       const std::string& help_default = option->get_default_str();
       if (!option->nonpositional() || help_default.empty()) continue;
       const std::string name = option->get_name();
@@ -59,7 +59,7 @@ TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
       CLI::App given_app;
       Command given_root(&given_app);
       std::vector<Subcommand> given = AddCommands(given_root);
-      std::vector<std::string> arguments = CommandPath(given[c].app->app());
+      std::vector<std::string> arguments = CommandPath(given[c].app->cli_app());
       arguments.push_back(name + "=" + help_default);
       std::reverse(arguments.begin(), arguments.end());  // CLI11 takes them last first
       try {
@@ -67,7 +67,7 @@ TEST(CommandLine, EveryFlagsHelpShowsTheDefaultOfAFreshStruct) {
       } catch (const CLI::RequiredError&) {
         // the command's positional arguments: the flags are read before that check
       }
-      EXPECT_EQ(CurrentValues(given[c].app->app()), defaults) << name << "=" << help_default;
+      EXPECT_EQ(CurrentValues(given[c].app->cli_app()), defaults) << name << "=" << help_default;
       ++checked;
     }
   }
@@ -80,7 +80,7 @@ TEST(CommandLine, NoHelpTextTypesInANumericDefault) {
   const std::vector<Subcommand> commands = AddCommands(root);
   const std::regex typed_in(R"(default:? -?[0-9])");
   for (const Subcommand& command : commands) {
-    for (const CLI::Option* option : command.app->app()->get_options()) {
+    for (const CLI::Option* option : command.app->cli_app()->get_options()) {
       EXPECT_FALSE(std::regex_search(option->get_description(), typed_in))
           << option->get_name() << ": " << option->get_description();
     }

@@ -67,18 +67,16 @@ class Flag {
   Flag* TypeName(const std::string& name);
   /// A list in one argument, comma-separated ("1,2,3").
   Flag* CommaSeparated();
-  /// A positional argument taking every remaining argument (one at least).
+  /// Takes one value or more (a flag: the arguments after it, up to the next flag).
   Flag* OneOrMore();
-  CLI::Option* option() const { return option_; }
 
  private:
   CLI::Option* option_;
 };
 
 /// A command of the command line (a CLI11 app): its flags and subcommands, owned here.
-/// `Value` of AddOption and AddOptionFunction is one of the types src/cli/flags.cc
-/// instantiates (std::string, std::filesystem::path, double, int, int64_t, uint64_t and
-/// the std::optional and std::vector forms it lists); another is a link error.
+/// `Value` is one of the types src/cli/flags.cc instantiates, listed there for each
+/// function (another is a link error).
 class Command {
  public:
   /// Wraps `app` (not owned; it must outlive this).
@@ -102,7 +100,8 @@ class Command {
   Flag* AddSwitch(const std::string& name, bool& field, const std::string& help);
   /// Whether the command line chose this command.
   bool Parsed() const;
-  CLI::App* app() const { return app_; }
+  /// The CLI11 app, for tests that walk its options (they include liftoff/cli/cli11.h).
+  CLI::App* cli_app() const { return app_; }
 
  private:
   Flag* Keep(CLI::Option* option);
@@ -338,8 +337,8 @@ Status NameFlagIn(const Status& status, const std::vector<FieldFlag<Options>>& f
 Flag* AddListOption(Command& app, const std::string& flag, std::vector<std::string>& field,
                     const std::string& help);
 
-/// A subcommand on the command line: its CLI11 command (flags bound to its command struct)
-/// and the function that runs that struct once parsed.
+/// A subcommand on the command line: its Command (flags bound to its command struct) and
+/// the function that runs that struct once parsed.
 struct Subcommand {
   Command* app = nullptr;
   std::function<int(std::ostream& out, std::ostream& err)> run;
@@ -354,15 +353,15 @@ Subcommand RunsWith(Command* app, std::shared_ptr<Parsed> command,
           }};
 }
 
-/// The commands `add_commands` puts under a root command.
+/// Adds the commands under `root` and returns their Subcommands (AddCommands).
 using CommandTable = std::function<std::vector<Subcommand>(Command& root)>;
 
 /// Parses `argv` with a root command (`description` in its help, `version` printed by
-/// --version) holding `commands`, and runs the subcommand chosen. Exit codes: the Run
+/// --version) that `table` fills, and runs the subcommand chosen. Exit codes: the Run
 /// function's; usage errors kExitUsage; a FlagError its status' class; an exception
 /// kExitInternal (docs/cli.md).
 int RunCommandLine(const std::string& description, const std::string& version,
-                   const CommandTable& commands, int argc, const char* const* argv,
+                   const CommandTable& table, int argc, const char* const* argv,
                    std::ostream& out, std::ostream& err);
 
 }  // namespace liftoff::cli
