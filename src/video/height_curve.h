@@ -30,9 +30,9 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
 /// How much the curve's key frames scatter where the foot stands still (frames [first,
 /// last)), px: 1.4826 times the median of the absolute changes between consecutive key
 /// frames, over the square root of 2 (SuccessiveDifferenceSigma: a slow drift adds only its
-/// change per key frame). A lossy codec copies a still
-/// picture between key frames, so a rest window without one measures no noise at all,
-/// while each key frame quantises the foot's edge anew (re-drawn hard3d-07, --seed 4000).
+/// change per key frame). A lossy codec copies a still picture between key frames, so a
+/// rest window without one measures no noise at all, while each key frame quantises the
+/// foot's edge anew (re-drawn hard3d-07, --seed 4000).
 /// 0 with fewer than kMinKeyframeChanges changes; in an intra-only clip every frame is a key
 /// frame.
 inline constexpr size_t kMinKeyframeChanges = 4;
