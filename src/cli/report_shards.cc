@@ -225,7 +225,7 @@ json LedJson(const video::LedResult& led) {
   json pulses = json::array();
   for (const video::LedPulse& p : led.pulses) {
     pulses.push_back({p.on_ns, p.on_uncertainty_ns, p.first_lit_frame, Number(p.first_lit_fraction),
-                      Optional(p.off_ns), p.off_uncertainty_ns});
+                      Optional(p.off_ns), p.off_uncertainty_ns, p.missing_frames_before_on});
   }
   return {{"roi_px", Rect(led.roi_px)},       {"roi_located", led.roi_located},
           {"off_level", Number(led.off_level)}, {"on_level", Number(led.on_level)},
@@ -249,6 +249,7 @@ video::LedResult LedAt(const json& j) {
     pulse.first_lit_fraction = NumberFrom(p.at(3));
     pulse.off_ns = OptionalFrom<int64_t>(p.at(4));
     pulse.off_uncertainty_ns = p.at(5).get<int64_t>();
+    pulse.missing_frames_before_on = p.at(6).get<int>();
   }
   led.warnings = j.at("warnings").get<std::vector<std::string>>();
   led.trace_t_ns = j.at("trace_t_ns").get<std::vector<int64_t>>();

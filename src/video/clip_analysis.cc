@@ -368,6 +368,7 @@ json ClipAnalysis::ToJson() const {
                       {"on_uncertainty_ms", 1e-6 * static_cast<double>(pulse.on_uncertainty_ns)},
                       {"first_lit_frame", pulse.first_lit_frame},
                       {"first_lit_fraction", pulse.first_lit_fraction},
+                      {"missing_frames_before_on", pulse.missing_frames_before_on},
                       {"off_s", pulse.off_ns ? json(SecondsFromNs(*pulse.off_ns)) : json()}});
   }
   json document = {

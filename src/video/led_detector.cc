@@ -73,8 +73,9 @@ constexpr int kGainStride = 2;
 constexpr int kReferenceStride = 4;
 // A measured fraction of the exposure is known to within max(sigmas * its noise, margin)
 // (3 sigmas of a frame's noise: the frame's own and that of the two levels it is measured
-// between, medians of a few frames); the margin covers what noise estimates from a few frames miss (codec effects at the
-// step), so a frame lit 92 % or more may have been lit all along.
+// between, medians of a few frames); the margin covers what noise estimates from a few
+// frames miss (codec effects at the step), so a frame lit 92 % or more may have been lit
+// all along.
 constexpr double kFractionSigmas = 3.0;
 constexpr double kFractionMargin = 0.08;
 // A frame next to the step counts as partly lit above this fraction (or the noise band):
@@ -1207,11 +1208,12 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
     }
     if (lit >= 2 && fraction(lit - 1) > lit_above && fraction(lit) >= 1.0 - band) --lit;
     const double f = std::clamp(fraction(lit), 0.0, 1.0);
-    const InstantInterval interval =
-        internal::SwitchOnInterval(static_cast<double>(event.t_ns[lit - 1]), dark,
-                                   static_cast<double>(event.t_ns[lit]), lit_band(f), exposure);
-    pulse.on_ns = interval.Middle();
-    pulse.on_uncertainty_ns = interval.HalfWidth();
+    const internal::SwitchOnDating dating = internal::DateSwitchOn(
+        static_cast<double>(event.t_ns[lit - 1]), dark, static_cast<double>(event.t_ns[lit]),
+        lit_band(f), exposure, static_cast<double>(event.period_ns));
+    pulse.on_ns = static_cast<int64_t>(std::llround(dating.estimate_ns));
+    pulse.on_uncertainty_ns = dating.HalfWidth();
+    pulse.missing_frames_before_on = dating.missing_frames;
     pulse.first_lit_frame = event.index[lit];
     pulse.first_lit_fraction = f;
   } else {
@@ -1349,6 +1351,15 @@ Result<LedResult> LedDetector::Impl::Finish() const {
       result.roi_px = located ? LocatedRect(event) : options.roi_px;
     }
     result.pulses.push_back(DatePulse(event));
+  }
+  if (!result.pulses.empty() && result.pulses.front().missing_frames_before_on > 0) {
+    const LedPulse& first = result.pulses.front();
+    result.warnings.push_back(
+        Plural(first.missing_frames_before_on, "frame") + " missing just before the switch-on" +
+        " (before frame " + std::to_string(first.first_lit_frame) +
+        "): dated as seen by the first missing frame; its +- " +
+        FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) +
+        " ms covers the whole gap");
   }
   if (already_on) {
     result.warnings.push_back(

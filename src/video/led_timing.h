@@ -90,6 +90,43 @@ inline InstantInterval SwitchOnInterval(double t_dark_ns, LitFraction dark, doub
   return {t_dark_ns, t_lit_ns};  // unreachable: e -> 0 is always consistent
 }
 
+// A switch-on dated from the frames around it, allowing for frames missing between them.
+// `surely` holds every instant consistent with the two frames seen (SwitchOnInterval).
+// When frames are missing (the two frames more than 1.5 usual intervals apart) and the lit
+// frame was lit all through its exposure (it cannot date the switch itself), the estimate
+// takes the first missing frame, one usual interval after the dark one, as the first that
+// saw the LED, lit for an unknown part of its exposure: frames dropped because of the
+// change (a camera or its encoder reacting to it) are dropped from the first one that
+// changed. With the exposure E known that is the middle of [dark + E/2, first missing +
+// E/2]; unknown, the middle of the union over every E in (0, T]. A drop unrelated to the
+// switch could begin anywhere in the gap; `surely` covers the whole gap either way.
+// Otherwise the estimate is the middle of `surely`.
+struct SwitchOnDating {
+  InstantInterval surely;
+  double estimate_ns = 0.0;
+  int missing_frames = 0;  // frames missing between the dark and the lit frame
+  // the half-width of the narrowest interval centred on the estimate that holds `surely`
+  int64_t HalfWidth() const {
+    return static_cast<int64_t>(
+        std::ceil(std::max({0.0, estimate_ns - surely.low_ns, surely.high_ns - estimate_ns})));
+  }
+};
+
+inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_lit_ns,
+                                   LitFraction lit, ExposureRange exposure, double period_ns) {
+  SwitchOnDating dating;
+  dating.surely = SwitchOnInterval(t_dark_ns, dark, t_lit_ns, lit, exposure);
+  dating.estimate_ns = 0.5 * (dating.surely.low_ns + dating.surely.high_ns);
+  if (!(period_ns > 0.0) || t_lit_ns - t_dark_ns <= 1.5 * period_ns) return dating;
+  dating.missing_frames = static_cast<int>(std::lround((t_lit_ns - t_dark_ns) / period_ns)) - 1;
+  if (lit.high < 1.0) return dating;
+  const InstantInterval first_missing =
+      SwitchOnInterval(t_dark_ns, dark, t_dark_ns + period_ns, {0.0, 1.0}, exposure);
+  dating.estimate_ns = std::clamp(0.5 * (first_missing.low_ns + first_missing.high_ns),
+                                  dating.surely.low_ns, dating.surely.high_ns);
+  return dating;
+}
+
 // The switch-off instants consistent with frame `lit` (t_lit_ns, lit fraction in
 // [lit.low, lit.high]) and the next frame `dark` (t_dark_ns > t_lit_ns, lit fraction in
 // [0, dark.high]): the switch-on problem with time reversed (a centred exposure is

@@ -411,11 +411,52 @@ TEST(LedDetector, ADroppedFrameAtTheSwitchOnWidensTheIntervalToTheRealTimestamps
   ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
   const LedPulse& pulse = result->pulses[0];
   // the last dark frame is at 44 T, the first lit one at 46 T: the switch-on lies between
-  // them, dated at their middle with half their distance as the uncertainty
+  // them; taking the missing frame 45 T as the first lit ([44 T, 45.5 T] over every
+  // exposure up to T) dates it at 44.75 T, and the uncertainty reaches both frames seen
   const double error_ns = static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9;
   EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
-  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 45 * stream.PeriodNs(), 1e3);
-  EXPECT_NEAR(static_cast<double>(pulse.on_uncertainty_ns), stream.PeriodNs(), 1e3);
+  EXPECT_LE(std::abs(error_ns), 0.5 * stream.PeriodNs()) << result->Brief();
+  EXPECT_EQ(pulse.missing_frames_before_on, 1);
+  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 44.75 * stream.PeriodNs(), 1e3);
+  EXPECT_NEAR(static_cast<double>(pulse.on_uncertainty_ns), 1.25 * stream.PeriodNs(), 1e3);
+}
+
+TEST(LedDetector, FramesDroppedFromTheSwitchOnAreDatedAtTheFirstMissingFrame) {
+  TinyLedStream stream;
+  stream.on_s = 1.5 - 0.2 * stream.exposure_s;  // inside frame 45's exposure
+  stream.dropped = {45, 46};                    // the first lit frame and the next
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  const LedPulse& pulse = result->pulses[0];
+  // dark at 44 T, lit at 47 T; frame 45 T taken as the first lit, for an exposure of up to
+  // T (not told): [44 T, 45.5 T], dated at 44.75 T, within half a frame of the truth
+  // (44.86 T); the uncertainty still reaches both frames seen (2.25 T)
+  EXPECT_EQ(pulse.missing_frames_before_on, 2);
+  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 44.75 * stream.PeriodNs(), 1e3);
+  EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9),
+            0.5 * stream.PeriodNs());
+  EXPECT_NEAR(static_cast<double>(pulse.on_uncertainty_ns), 2.25 * stream.PeriodNs(), 1e3);
+  ASSERT_EQ(result->warnings.size(), 1u) << result->Brief();
+  EXPECT_NE(result->warnings[0].find("2 frames missing just before the switch-on"),
+            std::string::npos)
+      << result->warnings[0];
+}
+
+TEST(LedDetector, FramesDroppedBeforeTheSwitchOnStillHoldTheTruthInTheInterval) {
+  // the drop begins a frame before the one that saw the switch-on: the estimate (the first
+  // missing frame) is a frame early, and the interval still holds the truth
+  TinyLedStream stream;
+  stream.on_s = 1.5 - 0.2 * stream.exposure_s;
+  stream.dropped = {44, 45};
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  const LedPulse& pulse = result->pulses[0];
+  EXPECT_EQ(pulse.missing_frames_before_on, 2);
+  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 43.75 * stream.PeriodNs(), 1e3);
+  EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9),
+            static_cast<double>(pulse.on_uncertainty_ns));
 }
 
 TEST(LedDetector, TinyLedNeverOnInAFlickeringNoisyRegionIsNotFound) {

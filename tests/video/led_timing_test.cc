@@ -68,6 +68,57 @@ TEST(SwitchOnInterval, DroppedFramesWidenTheIntervalToTheRealTimestamps) {
   EXPECT_NEAR(partial.high_ns, 10.2 * kT, 1e-6);
 }
 
+TEST(DateSwitchOn, WithoutAGapTheEstimateIsTheIntervalsMiddle) {
+  const SwitchOnDating dating =
+      DateSwitchOn(9 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT}, kT);
+  EXPECT_EQ(dating.missing_frames, 0);
+  EXPECT_NEAR(dating.estimate_ns, 9.5 * kT, 1e-6);
+  EXPECT_EQ(dating.HalfWidth(), static_cast<int64_t>(0.5 * kT));
+}
+
+TEST(DateSwitchOn, AcrossAGapTheFirstMissingFrameIsTakenAsTheFirstLit) {
+  // two frames missing (8 T and 9 T): frame 8 T lit for some part of its exposure E in
+  // (0, T]: s in [7 T + E/2, 8 T + E/2], over every E: [7 T, 8.5 T], middle 7.75 T; the
+  // interval that surely holds it stays the whole gap [7 T, 10 T]
+  const SwitchOnDating unknown =
+      DateSwitchOn(7 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT}, kT);
+  EXPECT_EQ(unknown.missing_frames, 2);
+  EXPECT_NEAR(unknown.estimate_ns, 7.75 * kT, 1e-6);
+  EXPECT_NEAR(unknown.surely.low_ns, 7 * kT, 1e-6);
+  EXPECT_NEAR(unknown.surely.high_ns, 10 * kT, 1e-6);
+  EXPECT_EQ(unknown.HalfWidth(), static_cast<int64_t>(2.25 * kT));
+  // E = 0.5 T known: [7.25 T, 8.25 T], middle 7.75 T; surely [7.25 T, 9.75 T]
+  const SwitchOnDating known =
+      DateSwitchOn(7 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.5 * kT, 0.5 * kT}, kT);
+  EXPECT_NEAR(known.estimate_ns, 7.75 * kT, 1e-6);
+  EXPECT_NEAR(known.surely.low_ns, 7.25 * kT, 1e-6);
+  EXPECT_NEAR(known.surely.high_ns, 9.75 * kT, 1e-6);
+  EXPECT_EQ(known.HalfWidth(), static_cast<int64_t>(2 * kT));
+  // E = 0.8 T: [7.4 T, 8.4 T], middle 7.9 T
+  const SwitchOnDating longer =
+      DateSwitchOn(7 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.8 * kT, 0.8 * kT}, kT);
+  EXPECT_NEAR(longer.estimate_ns, 7.9 * kT, 1e-6);
+  // one frame missing, E = 0.5 T: [8.25 T, 9.25 T], middle 8.75 T
+  const SwitchOnDating one =
+      DateSwitchOn(8 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.5 * kT, 0.5 * kT}, kT);
+  EXPECT_EQ(one.missing_frames, 1);
+  EXPECT_NEAR(one.estimate_ns, 8.75 * kT, 1e-6);
+}
+
+TEST(DateSwitchOn, APartlyLitFrameAfterAGapDatesTheSwitchItself) {
+  const SwitchOnDating dating =
+      DateSwitchOn(7 * kT, {0.0, 0.0}, 10 * kT, {0.3, 0.3}, {0.0, kT}, kT);
+  EXPECT_EQ(dating.missing_frames, 2);
+  EXPECT_NEAR(dating.estimate_ns, 10.1 * kT, 1e-6);
+}
+
+TEST(DateSwitchOn, JitterBelowHalfAnIntervalIsNoGap) {
+  const SwitchOnDating dating =
+      DateSwitchOn(8.6 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT}, kT);
+  EXPECT_EQ(dating.missing_frames, 0);
+  EXPECT_NEAR(dating.estimate_ns, 9.3 * kT, 1e-6);
+}
+
 TEST(SwitchOnInterval, NoiseBandsWidenTheInterval) {
   // E = T; lit in [0.2, 0.4]: s in [t + 0.1 T, t + 0.3 T]; a dark frame lit up to 15 %
   // allows nothing earlier than 9 T + 0.35 T
