@@ -37,6 +37,9 @@ using internal::RectText;
 // no more than small ones).
 constexpr double kMarginFraction = 0.3;
 constexpr double kWorkRegionPx = 64.0;
+// A region whose smaller side is under this is enlarged to kWorkRegionPx (at 48 rather
+// than 32, the dev set at half size had d05 at +0.0012 rad instead of -0.0068).
+constexpr int kEnlargeBelowPx = 48;
 // Patch side in work px, and the spacing of candidate patches.
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
@@ -115,6 +118,9 @@ constexpr double kShortRiseThresholds = 6.0;
 // foot's edge by a threshold or more: the never-lifting d12 of shared/video-dev, encoded
 // again by OpenCV's H.264 writer, stayed above the threshold to its end).
 constexpr double kMinLiftThresholds = 4.0;
+// ... and never fewer px than this (a small robot's threshold is a fraction of a pixel:
+// d12 at half its size, 0.21 px a mm, had one foot patch step 1.1 px and stay there)
+constexpr double kMinLiftPxLossy = 2.0;
 // A lagging curve this many of its still noise's sigmas above the threshold (three frames)
 // bounds the liftoff from above (BoundByTheCurve).
 constexpr double kSurelyAboveSigmas = 2.0;
@@ -260,8 +266,13 @@ cv::Rect WorkRegion(const cv::Rect& roi, const cv::Size& size) {
 void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
   const cv::Rect& roi = options.foot_roi_px;
   work_px = WorkRegion(roi, size);
-  // never enlarged (enlarging a small region was measured worse)
-  scale = std::min(1.0, kWorkRegionPx / std::min(roi.width, roi.height));
+  // shrunk to kWorkRegionPx; a small region enlarged to it, so that a small foot still holds
+  // several patches (the dev set at half size: d07's 7 px foot in a 25 px region was
+  // "never lifts" at its own size, -0.0026 rad enlarged; hard3d-04 at seed 3000, -0.0151
+  // rad in a 24 px region, -0.0004 enlarged)
+  const int smaller = std::min(roi.width, roi.height);
+  scale = smaller < kEnlargeBelowPx ? kWorkRegionPx / smaller
+                                    : std::min(1.0, kWorkRegionPx / smaller);
   if (scale < 1) resizer = internal::AreaResizer(work_px.size(), scale);
   const auto to_work = [&](int v, int origin) {
     return static_cast<int>(std::lround((v - origin) * scale));
@@ -275,6 +286,10 @@ void FootTracker::Impl::MakeWorkImage(const cv::Mat& bgr) {
   const cv::Mat crop = bgr(work_px);
   if (scale < 1) {
     resizer.Apply(crop, work);
+  } else if (scale > 1) {
+    cv::Mat real;
+    crop.convertTo(real, CV_32FC3);
+    cv::resize(real, work, cv::Size(), scale, scale, cv::INTER_CUBIC);
   } else {
     crop.convertTo(work, CV_32FC3);
   }
@@ -889,9 +904,12 @@ std::string NeverLifts(bool no_cut, double max_rise_px, double threshold_px, boo
     return largest + ", below the " + FormatFixed(threshold_px, 2) + " px threshold held for " +
            FormatFixed(kSustainS, 1) + " s";
   }
-  if (lossy && max_rise_px < kMinLiftThresholds * threshold_px) {
-    return largest + ", under " + FormatFixed(kMinLiftThresholds, 0) + " times the " +
-           FormatFixed(threshold_px, 2) + " px threshold (a lift goes on rising)";
+  const double min_lift_px = std::max(kMinLiftThresholds * threshold_px, kMinLiftPxLossy);
+  if (lossy && max_rise_px < min_lift_px) {
+    return largest + ", under " + FormatFixed(min_lift_px, 2) + " px (" +
+           FormatFixed(kMinLiftThresholds, 0) + " times the " + FormatFixed(threshold_px, 2) +
+           " px threshold, at least " + FormatFixed(kMinLiftPxLossy, 0) +
+           " px: a lift goes on rising)";
   }
   return "";
 }

@@ -145,7 +145,9 @@ TEST(FootTracker, RiseMatchesTheRendererTruthToSubPixelAtSeveralHeights) {
   ASSERT_EQ(track->samples.size(), heights_px.size());
   for (size_t i = 0; i < heights_px.size(); ++i) {
     const double truth_px = scene.TrueRisePx(times_ns[i]);
-    EXPECT_NEAR(track->samples[i].rise_px, truth_px, 0.05) << "at " << heights_px[i] << " px";
+    // (0.06 px: the region, under 48 px, is enlarged by cubic interpolation, which costs
+    // up to 0.053 px here; 0.05 held at its own size)
+    EXPECT_NEAR(track->samples[i].rise_px, truth_px, 0.06) << "at " << heights_px[i] << " px";
     if (i >= 3) {
       EXPECT_GT(track->samples[i].quality, 0.95) << "frame " << i;
     }
@@ -358,7 +360,32 @@ TEST(FootTracker, AStillFootAKeyFrameMovedThreeThresholdsIsNoLift) {
   EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
   EXPECT_NE(track.status().message().find("the foot never lifts"), std::string::npos)
       << track.status().message();
-  EXPECT_NE(track.status().message().find("under 4 times"), std::string::npos)
+  EXPECT_NE(track.status().message().find("4 times the 0.50 px threshold"), std::string::npos)
+      << track.status().message();
+}
+
+TEST(FootTracker, ASmallRobotsStillFootAKeyFrameMovedUnderTwoPxIsNoLift) {
+  // the same still foot of a small robot (a 0.2 px threshold: 1 mm at 0.2 px a mm, d12 of
+  // shared/video-dev at half size): the key frame at 6 s moves its edge 1.2 px, six
+  // thresholds, and it stays there. Four thresholds are not enough here: under 2 px is no
+  // lift through a lossy codec.
+  const cv::Size size(200, 150);
+  const cv::Mat floor = Texture(size, 10, 90, 200), foot = Texture(size, 11, 0, 60);
+  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
+  cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
+  const auto draw = [&](double t_s) {
+    const double shown_px = t_s >= 6.0 - 1e-6 ? 1.2 : 0.0;
+    const cv::Mat f = ShiftedUp(foot_mask, shown_px);
+    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px).mul(f));
+  };
+  FootTracker::Options options = DrawnOptions(cv::Rect(75, 55, 50, 50));
+  options.threshold_px = 0.2;
+  options.compression_error_px = 0.2;  // a lossy codec
+  const Result<FootTrack> track =
+      TrackDrawn(options, 300, draw, [](int64_t index) { return index % 60 == 0; });
+  ASSERT_FALSE(track.ok()) << track->Brief();
+  EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
+  EXPECT_NE(track.status().message().find("under 2.00 px"), std::string::npos)
       << track.status().message();
 }
 

@@ -17,8 +17,12 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "liftoff/core/robot.h"
 #include "liftoff/video/clip_analysis.h"
@@ -194,6 +198,78 @@ TEST(VideoDevSet, EveryClipMeetsTheTargets) {
       << led_never_on->status.ToString();
   EXPECT_NE(never_lifts->status.message().find("the foot never lifts"), std::string::npos)
       << never_lifts->status.ToString();
+}
+
+// A small robot in frame, from footage we did not make: every constant-rate dev clip
+// shrunk to half its width and height (area averaging, H.264 through OpenCV's writer)
+// with its truth scaled to match: a side view's foot is then 7 px across and 1 mm is 0.21
+// to 0.28 px. Targets asserted: the rejects rejected, every ok clip measured with the LED
+// within half a frame and the truth inside its interval, every rotation within 0.015 rad
+// and 8 of the 10 within 0.005 rad (measured: 8 within 0.005, 9 within 0.01, the largest
+// d01's 0.0128).
+fs::path WriteHalfSizeClip(const fs::path& from, const fs::path& to) {
+  std::ifstream in(from / "truth.json");
+  nlohmann::json truth = nlohmann::json::parse(in);
+  cv::VideoCapture capture((from / truth.at("video").get<std::string>()).string(), cv::CAP_FFMPEG);
+  cv::Mat frame, half;
+  if (!capture.read(frame)) return {};
+  fs::create_directories(to);
+  cv::VideoWriter writer((to / "video.mp4").string(), cv::CAP_FFMPEG,
+                         cv::VideoWriter::fourcc('a', 'v', 'c', '1'),
+                         truth.at("nominal_fps").get<double>(),
+                         cv::Size(frame.cols / 2, frame.rows / 2));
+  if (!writer.isOpened()) return {};
+  do {
+    cv::resize(frame, half, cv::Size(frame.cols / 2, frame.rows / 2), 0, 0, cv::INTER_AREA);
+    writer.write(half);
+  } while (capture.read(frame));
+  const auto halve = [](const nlohmann::json& rect) {
+    const int x = rect.at(0).get<int>() / 2, y = rect.at(1).get<int>() / 2;
+    const int right = (rect.at(0).get<int>() + rect.at(2).get<int>() + 1) / 2;
+    const int bottom = (rect.at(1).get<int>() + rect.at(3).get<int>() + 1) / 2;
+    return nlohmann::json::array({x, y, right - x, bottom - y});
+  };
+  truth["video"] = "video.mp4";
+  truth["led_roi"] = halve(truth.at("led_roi"));
+  truth["foot_roi"] = halve(truth.at("foot_roi"));
+  truth["pixels_per_mm"] = 0.5 * truth.at("pixels_per_mm").get<double>();
+  std::ofstream((to / "truth.json").string()) << truth.dump();
+  std::printf("%s at half size: %.2f px a mm, foot region %dx%d px\n",
+              from.filename().string().c_str(), truth.at("pixels_per_mm").get<double>(),
+              truth.at("foot_roi").at(2).get<int>(), truth.at("foot_roi").at(3).get<int>());
+  return to;
+}
+
+TEST(VideoDevSetAtHalfSize, EveryClipMeetsTheSmallRobotTargets) {
+  const fs::path root = fs::path(LIFTOFF_SHARED_DIR) / "video-dev";
+  if (!fs::exists(root)) GTEST_SKIP() << root << " is absent (a fresh clone has no ../shared)";
+  const fs::path half = fs::temp_directory_path() /
+                        ("liftoff-dev-half-" + std::to_string(::getpid()));
+  for (const fs::directory_entry& entry : fs::directory_iterator(root)) {
+    if (!fs::exists(entry.path() / "truth.json")) continue;
+    std::ifstream in(entry.path() / "truth.json");
+    // the writer keeps a constant rate: the variable-rate clip stays out
+    if (nlohmann::json::parse(in).at("timing").get<std::string>() != "cfr") continue;
+    ASSERT_FALSE(WriteHalfSizeClip(entry.path(), half / entry.path().filename()).empty())
+        << entry.path() << ": OpenCV's H.264 writer is not available";
+  }
+  const std::vector<ClipScore> scores = ScoreFolder(half);
+  fs::remove_all(half);
+  size_t ok_clips = 0, within_5mrad = 0;
+  for (const ClipScore& s : scores) {
+    if (!s.expect_ok) {
+      EXPECT_EQ(s.status.code(), StatusCode::kNotFound) << s.id << ": " << s.status.ToString();
+      continue;
+    }
+    ASSERT_TRUE(s.status.ok()) << s.id << ": " << s.status.ToString();
+    ++ok_clips;
+    EXPECT_LE(std::abs(s.led_error_frames), 0.5) << s.id;
+    EXPECT_TRUE(s.truth_inside) << s.id;
+    EXPECT_LE(std::abs(s.rotation_error_rad), 0.015) << s.id;
+    if (std::abs(s.rotation_error_rad) <= 0.005) ++within_5mrad;
+  }
+  EXPECT_EQ(ok_clips, 10u);
+  EXPECT_GE(within_5mrad, 8u);
 }
 
 // Any folder of clips in the same format, such as `liftoff synth --set hard3d -o DIR`:
