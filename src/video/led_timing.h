@@ -18,12 +18,15 @@
 
 namespace liftoff::video::internal {
 
+// Half-widths are capped here, ns (about 146 years: far inside int64).
+constexpr double kMaxNs = 4.6e18;
+
 // A closed interval of instants, ns (double: sub-ns maths, rounded at the end).
 struct InstantInterval {
   double low_ns = 0.0, high_ns = 0.0;
   int64_t Middle() const { return static_cast<int64_t>(std::llround(0.5 * (low_ns + high_ns))); }
-  int64_t HalfWidth() const {
-    return static_cast<int64_t>(std::ceil(0.5 * std::max(0.0, high_ns - low_ns)));
+  int64_t HalfWidth() const {  // (bounded: never beyond int64)
+    return static_cast<int64_t>(std::ceil(std::min(0.5 * std::max(0.0, high_ns - low_ns), kMaxNs)));
   }
   bool Contains(double t_ns) const { return t_ns >= low_ns && t_ns <= high_ns; }
 };
@@ -107,8 +110,8 @@ struct SwitchOnDating {
   int missing_frames = 0;  // frames missing between the dark and the lit frame
   // the half-width of the narrowest interval centred on the estimate that holds `surely`
   int64_t HalfWidth() const {
-    return static_cast<int64_t>(
-        std::ceil(std::max({0.0, estimate_ns - surely.low_ns, surely.high_ns - estimate_ns})));
+    return static_cast<int64_t>(std::ceil(std::min(
+        std::max({0.0, estimate_ns - surely.low_ns, surely.high_ns - estimate_ns}), kMaxNs)));
   }
 };
 
@@ -118,7 +121,9 @@ inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_
   dating.surely = SwitchOnInterval(t_dark_ns, dark, t_lit_ns, lit, exposure);
   dating.estimate_ns = 0.5 * (dating.surely.low_ns + dating.surely.high_ns);
   if (!(period_ns > 0.0) || t_lit_ns - t_dark_ns <= 1.5 * period_ns) return dating;
-  dating.missing_frames = static_cast<int>(std::lround((t_lit_ns - t_dark_ns) / period_ns)) - 1;
+  // (bounded: a gap of hours between two frames must not overflow the count)
+  const double intervals = std::min(std::round((t_lit_ns - t_dark_ns) / period_ns), 1e9);
+  dating.missing_frames = static_cast<int>(intervals) - 1;
   if (lit.high < 1.0) return dating;
   const InstantInterval first_missing =
       SwitchOnInterval(t_dark_ns, dark, t_dark_ns + period_ns, {0.0, 1.0}, exposure);

@@ -112,6 +112,18 @@ TEST(DateSwitchOn, APartlyLitFrameAfterAGapDatesTheSwitchItself) {
   EXPECT_NEAR(dating.estimate_ns, 10.1 * kT, 1e-6);
 }
 
+TEST(DateSwitchOn, AGapOfAnyLengthIsCountedWithoutOverflow) {
+  const SwitchOnDating dating = DateSwitchOn(0.0, {0.0, 0.0}, 9e18, {1.0, 1.0}, {0.0, 1.0}, 1.0);
+  EXPECT_EQ(dating.missing_frames, 999'999'999);
+  EXPECT_TRUE(dating.surely.Contains(dating.estimate_ns));
+  EXPECT_GT(dating.HalfWidth(), 0);
+  // a gap wider than int64 can hold as a half-width is capped, not wrapped
+  const SwitchOnDating wider =
+      DateSwitchOn(-9e18, {0.0, 0.0}, 9e18, {1.0, 1.0}, {0.0, 1.0}, 1.0);
+  EXPECT_EQ(wider.HalfWidth(), static_cast<int64_t>(kMaxNs));
+  EXPECT_EQ(wider.surely.HalfWidth(), static_cast<int64_t>(kMaxNs));
+}
+
 TEST(DateSwitchOn, JitterBelowHalfAnIntervalIsNoGap) {
   const SwitchOnDating dating =
       DateSwitchOn(8.6 * kT, {0.0, 0.0}, 10 * kT, {1.0, 1.0}, {0.0, kT}, kT);
