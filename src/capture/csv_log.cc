@@ -109,9 +109,10 @@ ParsedLine ParseLine(std::string_view content, const ColumnIndex& index,
   const std::optional<double> angle = ParseNumber(fields[index.angle]);
   const bool counts = columns.angle_unit == "counts";
   if (!angle || (counts && (std::trunc(*angle) != *angle || std::abs(*angle) > kMaxCounts))) {
-    parsed.bad = columns.angle_column + ": expected " +
-                 (counts ? std::string("whole encoder counts") : "a finite angle in " + columns.angle_unit) +
-                 ", got " + Quote(fields[index.angle]);
+    parsed.bad =
+        columns.angle_column + ": expected " +
+        (counts ? std::string("whole encoder counts") : "a finite angle in " + columns.angle_unit) +
+        ", got " + Quote(fields[index.angle]);
     return parsed;
   }
   if (counts) {

@@ -54,8 +54,8 @@ class CampaignProgress {
  private:
   void ShowLocked() {
     const double wall_s = std::max(SecondsFromNs(MonotonicNowNs() - started_ns_), 1e-3);
-    std::string text = std::to_string(done_) + " of " + Plural(static_cast<int64_t>(trials_), "trial") +
-                       " done";
+    std::string text =
+        std::to_string(done_) + " of " + Plural(static_cast<int64_t>(trials_), "trial") + " done";
     if (!running_.empty()) text += ", analysing";
     size_t listed = 0;
     for (const auto& [trial, frames] : running_) {

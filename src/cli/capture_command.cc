@@ -62,7 +62,9 @@ int RunCapture(const CaptureCommand& command, std::ostream& out, std::ostream& e
   ScopedStopSignals signals(command.handle_signals);
   std::function<void(const capture::CaptureStatus&)> on_status;
   if (!status_line->off()) {
-    on_status = [&](const capture::CaptureStatus& status) { status_line->Show(StatusText(status)); };
+    on_status = [&](const capture::CaptureStatus& status) {
+      status_line->Show(StatusText(status));
+    };
   }
   err << "capturing " << command.port << " -> " << options.log_path.string() << " (journal "
       << options.JournalPath().string() << "); Ctrl-C stops\n";

@@ -54,7 +54,8 @@ void ProgressLine::Line(const std::string& text) {
 }
 
 void ProgressLine::Clear() {
-  if (live_ && last_width_ > 0) *err_ << '\r' << std::string(last_width_, ' ') << '\r' << std::flush;
+  if (live_ && last_width_ > 0)
+    *err_ << '\r' << std::string(last_width_, ' ') << '\r' << std::flush;
   last_width_ = 0;
 }
 

@@ -244,7 +244,8 @@ std::string FitMarkdown(const ReportCalibration& calibration, const ReportComman
     text += "| " + std::string(FootName(target.foot)) + " | " + std::to_string(target.summary.n) +
             " | " + FormatFixed(target.summary.mean, 3) + " | " +
             FormatFixed(target.standard_error_rad, 4) + " | " +
-            FormatFixed(target.measurement_rad, 4) + " | " + FormatFixed(*fitted.feet[f].sim_rad, 3) + " | " +
+            FormatFixed(target.measurement_rad, 4) + " | " +
+            FormatFixed(*fitted.feet[f].sim_rad, 3) + " | " +
             (std::isfinite(run) ? FormatFixed(run, 3) : std::string("no value")) + " | " +
             Signed(fitted.feet[f].z, 1) + " |\n";
   }

@@ -57,7 +57,8 @@ Status CheckOutsideOutput(const fs::path& input, const fs::path& dir, std::strin
 // every file the report reads: manifest, calibration, logs, videos (TrialInputs), model
 Status CheckInputsOutsideOutput(const ReportCommand& command, const CampaignAnalysis& campaign) {
   std::vector<NamedPath> inputs;
-  if (fs::is_regular_file(command.manifest_path)) inputs.push_back({"manifest", command.manifest_path});
+  if (fs::is_regular_file(command.manifest_path))
+    inputs.push_back({"manifest", command.manifest_path});
   for (NamedPath& input : TrialInputs(campaign.manifest)) inputs.push_back(std::move(input));
   inputs.push_back({"calibration", campaign.calibration.source_path});
   if (!command.no_sim) inputs.push_back({"model", ModelPathFrom(command.sweep.experiment)});
@@ -149,7 +150,8 @@ Result<SimColumn> LoadCachedColumn(const fs::path& path) {
     curve.height_m = entry.NumberArray("height_m");
   }
   const Status read = reader.Finish();
-  if (!read.ok()) return Status(read.code(), read.message() + "; delete the file to rerun the sweep");
+  if (!read.ok())
+    return Status(read.code(), read.message() + "; delete the file to rerun the sweep");
   LIFTOFF_ASSIGN_OR_RETURN(column.results, stats::SimResultsFromJson(*results, path.string()));
   column.cache_path = path;
   column.from_cache = true;
@@ -281,16 +283,17 @@ std::vector<std::pair<std::string, std::string>> Provenance(const ReportContent&
 std::string ReportMarkdown(const ReportContent& content) {
   std::string text = "# liftoff report\n\n";
   for (const auto& [label, value] : Provenance(content)) text += "- " + label + ": " + value + "\n";
-  text += "\n## Table\n\n" + stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) +
-          "\n" +
-          stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown,
-                                  content.campaign->analysis.calibration, content.table->lookup_rule) +
-          "\n## Figures\n\n";
+  text +=
+      "\n## Table\n\n" + stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) +
+      "\n" +
+      stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown,
+                              content.campaign->analysis.calibration, content.table->lookup_rule) +
+      "\n## Figures\n\n";
   if (!content.drawn.ok()) text += "Not drawn: " + content.drawn.ToString() + "\n\n";
   for (const Figure& figure : content.figures) {
     if (content.drawn.ok()) text += "![" + figure.title + "](figures/" + figure.name + ".png)\n\n";
-    text += "Script [figures/" + figure.name + ".gp](figures/" + figure.name + ".gp), data [figures/" +
-            figure.name + ".dat](figures/" + figure.name + ".dat)\n\n";
+    text += "Script [figures/" + figure.name + ".gp](figures/" + figure.name +
+            ".gp), data [figures/" + figure.name + ".dat](figures/" + figure.name + ".dat)\n\n";
   }
   if (content.calibration) text += CalibrationMarkdown(*content.calibration, "##") + "\n";
   return text + TrialsMarkdown(*content.campaign, content.evidence, content.drawn.ok());
@@ -315,7 +318,8 @@ std::string HtmlTable(const stats::ResultsTable& table) {
             HtmlNumber(hw.ci_high) + "]</td></tr>\n";
   }
   html += "</table>\n<p>" + EscapeMarkup(table.title) + ", rad; calibration " +
-          EscapeMarkup(table.calibration) + "; lookup " + EscapeMarkup(table.lookup_rule) + "</p>\n";
+          EscapeMarkup(table.calibration) + "; lookup " + EscapeMarkup(table.lookup_rule) +
+          "</p>\n";
   for (const std::string& note : table.notes) html += "<p>note: " + EscapeMarkup(note) + "</p>\n";
   return html;
 }
@@ -327,12 +331,14 @@ Result<std::string> ReportHtml(const ReportContent& content, const fs::path& dir
       "<title>liftoff report</title>\n<style>body{font-family:sans-serif;max-width:1250px;"
       "margin:auto}table{border-collapse:collapse}td,th{border:1px solid #999;padding:2px 8px;"
       "text-align:right}img{max-width:100%}.evidence{display:flex;gap:8px;align-items:flex-start}"
-      ".evidence figure{flex:1;margin:4px 0}</style>\n</head>\n<body>\n<h1>liftoff report</h1>\n<ul>\n";
+      ".evidence figure{flex:1;margin:4px 0}</style>\n</head>\n<body>\n<h1>liftoff "
+      "report</h1>\n<ul>\n";
   for (const auto& [label, value] : Provenance(content)) {
     html += "<li>" + label + ": " + EscapeMarkup(value) + "</li>\n";
   }
   html += "</ul>\n<h2>Table</h2>\n" + HtmlTable(*content.table) + "<h2>Figures</h2>\n";
-  if (!content.drawn.ok()) html += "<p>Not drawn: " + EscapeMarkup(content.drawn.ToString()) + "</p>\n";
+  if (!content.drawn.ok())
+    html += "<p>Not drawn: " + EscapeMarkup(content.drawn.ToString()) + "</p>\n";
   for (const Figure& figure : content.figures) {
     if (!content.drawn.ok()) continue;
     LIFTOFF_ASSIGN_OR_RETURN(const std::string img,
@@ -341,8 +347,8 @@ Result<std::string> ReportHtml(const ReportContent& content, const fs::path& dir
             "</figcaption></figure>\n";
   }
   if (content.calibration) html += CalibrationHtml(*content.calibration);
-  LIFTOFF_ASSIGN_OR_RETURN(const std::string trials,
-                           TrialsHtml(*content.campaign, content.evidence, content.drawn.ok(), dir));
+  LIFTOFF_ASSIGN_OR_RETURN(const std::string trials, TrialsHtml(*content.campaign, content.evidence,
+                                                                content.drawn.ok(), dir));
   return html + trials + "</body>\n</html>\n";
 }
 
@@ -353,9 +359,10 @@ Status WriteTables(const ReportContent& content, const fs::path& dir) {
   const std::string& calibration = content.campaign->analysis.calibration;
   const std::string& rule = content.table->lookup_rule;
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(
-      dir / "table.md",
-      stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) + "\n" +
-          stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown, calibration, rule)));
+      dir / "table.md", stats::RenderResultsTable(*content.table, stats::TableFormat::kMarkdown) +
+                            "\n" +
+                            stats::RenderTrialTable(*content.values, stats::TableFormat::kMarkdown,
+                                                    calibration, rule)));
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(
       dir / "table.csv", stats::RenderResultsTable(*content.table, stats::TableFormat::kCsv)));
   return WriteFileAtomically(
@@ -380,7 +387,8 @@ Status WriteFiguresAndPages(ReportContent& content, std::ostream& err) {
     LIFTOFF_RETURN_IF_ERROR(WriteCalibrationFiles(*content.calibration, dir));
   }
   for (const Figure& figure : content.figures) {
-    LIFTOFF_RETURN_IF_ERROR(WriteFigure(figure, figures_dir, content.command->gnuplot, content.drawn));
+    LIFTOFF_RETURN_IF_ERROR(
+        WriteFigure(figure, figures_dir, content.command->gnuplot, content.drawn));
   }
   LIFTOFF_ASSIGN_OR_RETURN(
       content.evidence,

@@ -227,11 +227,15 @@ json LedJson(const video::LedResult& led) {
     pulses.push_back({p.on_ns, p.on_uncertainty_ns, p.first_lit_frame, Number(p.first_lit_fraction),
                       Optional(p.off_ns), p.off_uncertainty_ns, p.missing_frames_before_on});
   }
-  return {{"roi_px", Rect(led.roi_px)},       {"roi_located", led.roi_located},
-          {"off_level", Number(led.off_level)}, {"on_level", Number(led.on_level)},
+  return {{"roi_px", Rect(led.roi_px)},
+          {"roi_located", led.roi_located},
+          {"off_level", Number(led.off_level)},
+          {"on_level", Number(led.on_level)},
           {"contrast_levels", Number(led.contrast_levels)},
-          {"pulses", pulses},                 {"warnings", led.warnings},
-          {"trace_t_ns", led.trace_t_ns},       {"trace_brightness_levels", NumbersJson(led.trace_brightness_levels)}};
+          {"pulses", pulses},
+          {"warnings", led.warnings},
+          {"trace_t_ns", led.trace_t_ns},
+          {"trace_brightness_levels", NumbersJson(led.trace_brightness_levels)}};
 }
 
 video::LedResult LedAt(const json& j) {
@@ -289,28 +293,29 @@ std::vector<video::HeightSample> SamplesAt(const json& j) {
 }
 
 json FootJson(const video::FootTrack& f) {
-  return {{"samples", SamplesJson(f.samples)},
-          {"foot_roi_px", Rect(f.foot_roi_px)},
-          {"reference_roi_px", Rect(f.reference_roi_px)},
-          {"reference_patches_px", Rects(f.reference_patches_px)},
-          {"foot_patches_px", Rects(f.foot_patches_px)},
-          {"foot_px", {Number(f.foot_center_x_px), Number(f.foot_width_px), Number(f.foot_bottom_px)}},
-          {"located_by_tape", f.located_by_tape},
-          {"rest_rise_px", Number(f.rest_rise_px)},
-          {"rest_noise_px", Number(f.rest_noise_px)},
-          {"still_noise_px", Number(f.still_noise_px)},
-          {"px_per_mm", Number(f.px_per_mm)},
-          {"px_per_mm_estimated", f.px_per_mm_estimated},
-          {"threshold_px", Number(f.threshold_px)},
-          {"max_rise_px", Number(f.max_rise_px)},
-          {"exposure_offset_ns", f.exposure_offset_ns},
-          {"fit_frames", {f.fit_first_frame, f.fit_last_frame}},
-          {"fit_noise_px", Number(f.fit_noise_px)},
-          {"low_confidence", f.low_confidence},
-          {"poor_frames", f.poor_frames},
-          {"onset", EventJson(f.onset)},
-          {"above_threshold", EventJson(f.above_threshold)},
-          {"warnings", f.warnings}};
+  return {
+      {"samples", SamplesJson(f.samples)},
+      {"foot_roi_px", Rect(f.foot_roi_px)},
+      {"reference_roi_px", Rect(f.reference_roi_px)},
+      {"reference_patches_px", Rects(f.reference_patches_px)},
+      {"foot_patches_px", Rects(f.foot_patches_px)},
+      {"foot_px", {Number(f.foot_center_x_px), Number(f.foot_width_px), Number(f.foot_bottom_px)}},
+      {"located_by_tape", f.located_by_tape},
+      {"rest_rise_px", Number(f.rest_rise_px)},
+      {"rest_noise_px", Number(f.rest_noise_px)},
+      {"still_noise_px", Number(f.still_noise_px)},
+      {"px_per_mm", Number(f.px_per_mm)},
+      {"px_per_mm_estimated", f.px_per_mm_estimated},
+      {"threshold_px", Number(f.threshold_px)},
+      {"max_rise_px", Number(f.max_rise_px)},
+      {"exposure_offset_ns", f.exposure_offset_ns},
+      {"fit_frames", {f.fit_first_frame, f.fit_last_frame}},
+      {"fit_noise_px", Number(f.fit_noise_px)},
+      {"low_confidence", f.low_confidence},
+      {"poor_frames", f.poor_frames},
+      {"onset", EventJson(f.onset)},
+      {"above_threshold", EventJson(f.above_threshold)},
+      {"warnings", f.warnings}};
 }
 
 video::FootTrack FootAt(const json& j) {

@@ -83,7 +83,8 @@ Result<sim::ModelDescription> LoadDescription(const SimExperimentChoice& choice)
 class SimProgress {
  public:
   static Result<SimProgress> Create(std::string_view mode, std::ostream& err) {
-    LIFTOFF_ASSIGN_OR_RETURN(ProgressLine line, ProgressLine::Create(mode, "--progress", "sim", err));
+    LIFTOFF_ASSIGN_OR_RETURN(ProgressLine line,
+                             ProgressLine::Create(mode, "--progress", "sim", err));
     return SimProgress(std::move(line));
   }
 
@@ -337,9 +338,10 @@ const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags() {
             const sim::PretensionRatios& r = o.pretension_ratios;
             return std::vector<double>{r.top_m, r.bottom_m, r.saddle_m, r.side_m};
           },
-          [](O& o, const std::vector<double>& v) { o.pretension_ratios = {v[0], v[1], v[2], v[3]}; },
-          "four numbers TOP,BOTTOM,SADDLE,SIDE in m (T0 / k)",
-          "T0/k of HT,HB,saddles,sides, m"),
+          [](O& o, const std::vector<double>& v) {
+            o.pretension_ratios = {v[0], v[1], v[2], v[3]};
+          },
+          "four numbers TOP,BOTTOM,SADDLE,SIDE in m (T0 / k)", "T0/k of HT,HB,saddles,sides, m"),
       NumberFlag<O>("--friction", LIFTOFF_FIELD(friction), kSameUnit,
                     "Ground friction coefficient (default: the model's)"),
       NumberFlag<O>("--spine-friction", LIFTOFF_FIELD(spine_friction), kSameUnit,
@@ -357,7 +359,9 @@ const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags() {
                     "Rest length from the attachment or node distance (default: the model's)"),
       ChoiceFlagOf<O, Collisions>(
           "--collisions", "spine_ground_collisions",
-          {{"feet", {false, false}}, {"ground", {true, false}}, {"self", {false, true}},
+          {{"feet", {false, false}},
+           {"ground", {true, false}},
+           {"self", {false, true}},
            {"all", {true, true}}},
           [](const O& o) -> std::optional<Collisions> {
             if (!o.spine_ground_collisions && !o.spine_self_collisions) return std::nullopt;

@@ -52,7 +52,8 @@ Status CheckInstantSources(const SyncCommand& command) {
                                 "--foot-roi x,y,w,h to find them");
   }
   if (from_video && command.clip.foot_roi.empty()) {
-    return InvalidArgumentError("--video needs --foot-roi x,y,w,h: the liftoff comes from the foot");
+    return InvalidArgumentError(
+        "--video needs --foot-roi x,y,w,h: the liftoff comes from the foot");
   }
   return Status::Ok();
 }
@@ -97,9 +98,9 @@ void PrintSync(const Calibration& calibration, const sync::LookupOptions& lookup
       << "interval LED on -> liftoff: " << FormatSeconds(measured.interval_ns, 3) << " s +- "
       << FormatSeconds(measured.interval_uncertainty_ns, 3) << " s\n"
       << "log instant: " << FormatSeconds(measured.liftoff_log_ns, 3) << " s\n"
-      << "vertebra angle: " << FormatFixed(measured.lookup.vertebra_rad, 4) << " rad; at liftoff |angle| "
-      << FormatFixed(measured.liftoff_rad, 4) << " rad in [" << FormatFixed(measured.lower_rad, 4)
-      << ", " << FormatFixed(measured.upper_rad, 4) << "]\n";
+      << "vertebra angle: " << FormatFixed(measured.lookup.vertebra_rad, 4)
+      << " rad; at liftoff |angle| " << FormatFixed(measured.liftoff_rad, 4) << " rad in ["
+      << FormatFixed(measured.lower_rad, 4) << ", " << FormatFixed(measured.upper_rad, 4) << "]\n";
   for (const std::string& warning : measured.lookup.warnings) out << "note: " << warning << '\n';
 }
 

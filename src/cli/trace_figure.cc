@@ -147,11 +147,12 @@ std::string Body(const std::string& name, const std::string& trial_id,
     body += InstantMarks(instants) + "  set object 9 rect from " + Seconds(clip.rest_from_ns) +
             ", graph 0 to " + Seconds(clip.rest_to_ns) +
             ", graph 1 fc rgb \"#808080\" fs transparent solid 0.15 noborder behind\n"
-            "  set arrow 9 from graph 0, first " + threshold + " to graph 1, first " + threshold +
+            "  set arrow 9 from graph 0, first " +
+            threshold + " to graph 1, first " + threshold +
             " nohead dt 2 lc rgb \"#d62728\"\n"
             "  set title \"Foot height above rest (grey: rest window; dashed: threshold " +
-            FormatFixed(threshold_units, 2) + " " + unit + ")\"\n  set ylabel \"height (" + unit + ")\"\n  plot " +
-            data + " index " + (led_traced ? "2" : "1") +
+            FormatFixed(threshold_units, 2) + " " + unit + ")\"\n  set ylabel \"height (" + unit +
+            ")\"\n  plot " + data + " index " + (led_traced ? "2" : "1") +
             " using 1:2 with lines lw 1.5 lc rgb \"#1f77b4\" title \"foot\"";
     for (size_t row = 0; row < instants.size(); ++row) {
       body += ", \\\n       " + data + " index 0 every ::" + std::to_string(row) +

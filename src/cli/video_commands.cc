@@ -314,12 +314,13 @@ TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysi
 std::vector<Flag*> AddClipFlags(Command& app, ClipChoice& clip) {
   std::vector<Flag*> options;
   options.push_back(app.AddOption("--led-roi", clip.led_roi,
-                                   "LED region x,y,w,h in pixels (default: located automatically)"));
+                                  "LED region x,y,w,h in pixels (default: located automatically)"));
   options.push_back(app.AddOption("--foot-roi", clip.foot_roi,
                                    "Foot region x,y,w,h in pixels: the foot at rest and room "
                                    "above it (without it: the LED only)"));
-  options.push_back(app.AddOption(
-      "--foot", clip.foot, "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
+  options.push_back(
+      app.AddOption("--foot", clip.foot,
+                    "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
   options.push_back(app.AddOption("--px-per-mm", clip.px_per_mm,
                                    "Image scale at the foot, px per mm (0: from the foot's width)")
                         ->ShowDefault());

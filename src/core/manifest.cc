@@ -69,9 +69,11 @@ CsvLogColumns ReadCsvColumns(JsonReader& log) {
     columns.angle_unit = std::array{"rad", "deg", "counts"}[*unit];
   }
   columns.led_column = log.OptionalString("led_column");
-  columns.led_on_s = log.OptionalNumber("led_on_s", {.min = -kMaxTimeSeconds, .max = kMaxTimeSeconds});
-  for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"time_column", &columns.time_column},
-                                  {"angle_column", &columns.angle_column}}) {
+  columns.led_on_s =
+      log.OptionalNumber("led_on_s", {.min = -kMaxTimeSeconds, .max = kMaxTimeSeconds});
+  for (const auto& [key, name] :
+       {std::pair<const char*, const std::string*>{"time_column", &columns.time_column},
+        {"angle_column", &columns.angle_column}}) {
     if (!log.failed() && name->empty()) log.Fail(key, "expected a column name");
   }
   if (!log.failed() && columns.led_column && columns.led_on_s) {
@@ -214,7 +216,8 @@ Status ValidateTrials(const std::vector<TrialRecord>& trials, const std::string&
     }
     if (trial.log_path.empty()) return InvalidArgumentError(where + ": expected a log path");
     if ((trial.log_format == LogFormat::kCsv) != trial.log_columns.has_value()) {
-      return InvalidArgumentError(where + ": log: expected columns for a csv log, and only for one");
+      return InvalidArgumentError(where +
+                                  ": log: expected columns for a csv log, and only for one");
     }
     if (trial.test_number && *trial.test_number < 1) {
       return InvalidArgumentError(where + ": test number: expected an integer >= 1, got " +

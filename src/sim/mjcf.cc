@@ -208,7 +208,8 @@ class Writer {
   void FreeBody(int b) {
     const Body& body = model_.bodies[Index(b)];
     const Vec3 position = body.initial_position_m + Vec3(0.0, 0.0, options_.lift_m);
-    std::string open = "<body name=\"" + EscapeMarkup(body.name) + "\" pos=\"" + Vec(position) + "\"";
+    std::string open =
+        "<body name=\"" + EscapeMarkup(body.name) + "\" pos=\"" + Vec(position) + "\"";
     if (!IsIdentityQuat(body.initial_orientation)) {
       open += " quat=\"" + QuatText(body.initial_orientation) + "\"";
     }
@@ -260,9 +261,9 @@ class Writer {
               ? ((contact.spine_ground ? kGroundBit : 0) | (contact.spine_self ? kSpineSelfBit : 0))
               : 0;
       const int affinity = rod.collides && contact.spine_self ? kSpineSelfBit : 0;
-      Line(depth, "<geom name=\"" + prefix + EscapeMarkup(rod.name) + "\" type=\"capsule\" fromto=\"" +
-                      Vec(rod.from_m) + " " + Vec(rod.to_m) + "\" size=\"" + Num(rod.radius_m) +
-                      "\"" + Collision(type, affinity) +
+      Line(depth, "<geom name=\"" + prefix + EscapeMarkup(rod.name) +
+                      "\" type=\"capsule\" fromto=\"" + Vec(rod.from_m) + " " + Vec(rod.to_m) +
+                      "\" size=\"" + Num(rod.radius_m) + "\"" + Collision(type, affinity) +
                       (type != 0 ? FrictionAttributes(SpineFriction()) : "") +
                       " rgba=\"0.55 0.55 0.6 1\"/>");
     }
@@ -329,10 +330,10 @@ class Writer {
       Line(2, "<spatial name=\"" + EscapeMarkup(cable.name) + "\" springlength=\"" +
                   Num(cable.rest_length_m) + "\" stiffness=\"0\" damping=\"0\" rgba=\"" +
                   CableRgba(material) + "\">");
-      Line(3,
-           "<site site=\"" + EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), true)) + "\"/>");
-      Line(3,
-           "<site site=\"" + EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), false)) + "\"/>");
+      Line(3, "<site site=\"" + EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), true)) +
+                  "\"/>");
+      Line(3, "<site site=\"" +
+                  EscapeMarkup(MjcfCableSiteName(model_, static_cast<int>(c), false)) + "\"/>");
       Line(2, "</spatial>");
     }
     Line(1, "</tendon>");
@@ -346,10 +347,11 @@ class Writer {
         const Hinge& hinge = model_.hinges[h];
         Line(2, "<joint name=\"" +
                     EscapeMarkup(MjcfHingeDriveElementName(model_, static_cast<int>(h),
-                                                   options_.hinge_drive)) +
-                    "\" joint1=\"" + EscapeMarkup(hinge.name) + "\" polycoef=\"0 0 0 0 0\" solref=\"" +
-                    Num(HingeTimeConstant()) + " 1\" solimp=\"" + Num(options_.hinge_impedance) +
-                    " " + Num(options_.hinge_impedance) + " 0.001\"/>");
+                                                           options_.hinge_drive)) +
+                    "\" joint1=\"" + EscapeMarkup(hinge.name) +
+                    "\" polycoef=\"0 0 0 0 0\" solref=\"" + Num(HingeTimeConstant()) +
+                    " 1\" solimp=\"" + Num(options_.hinge_impedance) + " " +
+                    Num(options_.hinge_impedance) + " 0.001\"/>");
       }
       Line(1, "</equality>");
       return;
@@ -357,12 +359,12 @@ class Writer {
     Line(1, "<actuator>");
     for (size_t h = 0; h < model_.hinges.size(); ++h) {
       const Hinge& hinge = model_.hinges[h];
-      Line(2,
-           "<position name=\"" +
-               EscapeMarkup(MjcfHingeDriveElementName(model_, static_cast<int>(h), options_.hinge_drive)) +
-               "\" joint=\"" + EscapeMarkup(hinge.name) + "\" kp=\"" +
-               Num(options_.hinge_gain_n_m_per_rad) +
-               "\" ctrllimited=\"true\" ctrlrange=\"-3.14159 3.14159\"/>");
+      Line(2, "<position name=\"" +
+                  EscapeMarkup(MjcfHingeDriveElementName(model_, static_cast<int>(h),
+                                                         options_.hinge_drive)) +
+                  "\" joint=\"" + EscapeMarkup(hinge.name) + "\" kp=\"" +
+                  Num(options_.hinge_gain_n_m_per_rad) +
+                  "\" ctrllimited=\"true\" ctrlrange=\"-3.14159 3.14159\"/>");
     }
     Line(1, "</actuator>");
   }

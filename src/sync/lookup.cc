@@ -347,7 +347,8 @@ Result<LiftoffMeasurement> MeasureLiftoff(const ControllerLog& log, const EventT
 
   // the video's LED-on is the log's LED-on (the 2018 device clock starts there)
   const std::optional<int64_t> led_on_log_ns = log.LedOnTimeNs();
-  if (led_on_log_ns) LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's LED switch-on", *led_on_log_ns));
+  if (led_on_log_ns)
+    LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the log's LED switch-on", *led_on_log_ns));
   LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the video's LED switch-on", video_times.led_on_ns));
   LIFTOFF_RETURN_IF_ERROR(CheckLogTime("the video's liftoff", video_times.liftoff_ns));
   measurement.log_from_video.source_origin_ns = video_times.led_on_ns;

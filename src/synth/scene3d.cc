@@ -227,9 +227,11 @@ void WriteHalf(const Scene3dOptions& options, bool front, Foot lifting_foot, Mjc
     << cv::Vec3d(sign * kFootX, 0, kSpineZ) << "'/>\n";
   for (const int index : {1, 2}) {
     const cv::Vec3d centre(sign * index * kVertebraSpacing, 0, kSpineZ);
-    WriteVertebraRods(centre, "v" + std::to_string(3 + static_cast<int>(sign) * index), true, true, m);
+    WriteVertebraRods(centre, "v" + std::to_string(3 + static_cast<int>(sign) * index), true, true,
+                      m);
   }
-  const cv::Vec3d a(sign * kVertebraSpacing, 0, kSpineZ), b(sign * 2 * kVertebraSpacing, 0, kSpineZ);
+  const cv::Vec3d a(sign * kVertebraSpacing, 0, kSpineZ),
+      b(sign * 2 * kVertebraSpacing, 0, kSpineZ);
   const cv::Vec3d tips[4] = {{0.065, 0, 0.096}, {0.065, 0, -0.096}, {-0.065, -0.096, 0},
                              {-0.065, 0.096, 0}};
   for (const cv::Vec3d& tip : tips) {
@@ -327,7 +329,8 @@ Status Scene3dOptions::Validate() const {
     return out_of("light_elevation_deg", light_elevation_deg, 5, 90);
   if (!std::isfinite(light_azimuth_deg))
     return out_of("light_azimuth_deg", light_azimuth_deg, -360, 360);
-  if (!(light_level >= 0.05 && light_level <= 2)) return out_of("light_level", light_level, 0.05, 2);
+  if (!(light_level >= 0.05 && light_level <= 2))
+    return out_of("light_level", light_level, 0.05, 2);
   if (shadow_map_px < 256 || shadow_map_px > 8192)
     return out_of("shadow_map_px", shadow_map_px, 256, 8192);
   if (msaa_samples != 0 && msaa_samples != 2 && msaa_samples != 4 && msaa_samples != 8)
@@ -442,13 +445,15 @@ Result<mjModel*> CompileMjcf(const std::string& mjcf) {
   char error[1024] = "";
   mjModel* model = mj_loadXML(kFileName, vfs.get(), error, sizeof error);
   mj_deleteVFS(vfs.get());
-  if (model == nullptr) return InvalidArgumentError(std::string("scene3d: MuJoCo rejected the scene: ") + error);
+  if (model == nullptr)
+    return InvalidArgumentError(std::string("scene3d: MuJoCo rejected the scene: ") + error);
   return model;
 }
 
 cv::Vec3d Rotate(const cv::Vec3d& u, double angle, const cv::Vec3d& v) {
   // Rodrigues
-  return v * std::cos(angle) + u.cross(v) * std::sin(angle) + u * (u.dot(v)) * (1 - std::cos(angle));
+  return v * std::cos(angle) + u.cross(v) * std::sin(angle) +
+         u * (u.dot(v)) * (1 - std::cos(angle));
 }
 
 struct Tip {
@@ -483,7 +488,8 @@ Result<std::unique_ptr<SceneRenderer3d>> SceneRenderer3d::Create(const Scene3dOp
   LIFTOFF_RETURN_IF_ERROR(options.Validate());
   // MuJoCo's renderer ends the process when it has no context: check first
   if (eglGetCurrentContext() == EGL_NO_CONTEXT) {
-    return UnsupportedError("scene3d: no current OpenGL context on this thread (make an EglContext)");
+    return UnsupportedError(
+        "scene3d: no current OpenGL context on this thread (make an EglContext)");
   }
   auto impl = std::make_unique<Impl>();
   LIFTOFF_ASSIGN_OR_RETURN(impl->model, CompileMjcf(Scene3dMjcf(options, lifting_foot)));
@@ -512,7 +518,8 @@ Result<std::unique_ptr<SceneRenderer3d>> SceneRenderer3d::Create(const Scene3dOp
   }
   impl->camera.type = mjCAMERA_FIXED;
   impl->camera.fixedcamid = mj_name2id(impl->model, mjOBJ_CAMERA, "camera");
-  impl->rgb.resize(static_cast<size_t>(options.width_px) * static_cast<size_t>(options.height_px) * 3);
+  impl->rgb.resize(static_cast<size_t>(options.width_px) * static_cast<size_t>(options.height_px) *
+                   3);
 
   std::unique_ptr<SceneRenderer3d> renderer(new SceneRenderer3d(std::move(impl)));
   renderer->options_ = options;

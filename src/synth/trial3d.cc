@@ -98,7 +98,8 @@ struct Effects {
     };
     while (shake.size() <= frame) {
       const cv::Point2d last = shake.back();
-      const double dx = spec.shake_px * shake_rng.Gaussian(), dy = spec.shake_px * shake_rng.Gaussian();
+      const double dx = spec.shake_px * shake_rng.Gaussian(),
+                   dy = spec.shake_px * shake_rng.Gaussian();
       shake.emplace_back(reflect(last.x + dx), reflect(last.y + dy));
     }
     return spec.shake_px > 0 ? shake[frame] : cv::Point2d(0, 0);
@@ -195,7 +196,8 @@ Status Trial3dSpec::Validate() const {
       !std::all_of(id.begin(), id.end(), [](char c) {
         return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
       })) {
-    return InvalidArgumentError("trial3d: id: expected 1-100 of A-Z a-z 0-9 . _ -, got \"" + id + "\"");
+    return InvalidArgumentError("trial3d: id: expected 1-100 of A-Z a-z 0-9 . _ -, got \"" + id +
+                                "\"");
   }
   LIFTOFF_RETURN_IF_ERROR(scene.Validate().WithContext("trial3d " + id));
   if (tension_point_index < 0 || tension_point_index > 4)
@@ -215,7 +217,8 @@ Status Trial3dSpec::Validate() const {
   if (!(contact_floor_m >= 0 && contact_floor_m <= 1e-3))
     return OutOfRange(id, "contact_floor_m", contact_floor_m, 0, 1e-3);
   if (!(fps >= 1 && fps <= 240)) return OutOfRange(id, "fps", fps, 1, 240);
-  if (!(exposure_s > 0 && exposure_s <= 1 / fps)) return OutOfRange(id, "exposure_s", exposure_s, 0, 1 / fps);
+  if (!(exposure_s > 0 && exposure_s <= 1 / fps))
+    return OutOfRange(id, "exposure_s", exposure_s, 0, 1 / fps);
   if (!(drop_probability >= 0 && drop_probability <= 0.5))
     return OutOfRange(id, "drop_probability", drop_probability, 0, 0.5);
   if (!(timestamp_jitter_s >= 0 && timestamp_jitter_s <= 0.4 / fps))
@@ -223,16 +226,20 @@ Status Trial3dSpec::Validate() const {
   if (drop_frames_at_led < 0 || drop_frames_at_led > 5)
     return OutOfRange(id, "drop_frames_at_led", drop_frames_at_led, 0, 5);
   if (!(led_on_s >= 0.2 && led_on_s <= 60)) return OutOfRange(id, "led_on_s", led_on_s, 0.2, 60);
-  if (!(after_lift_s >= 0.1 && after_lift_s <= 10)) return OutOfRange(id, "after_lift_s", after_lift_s, 0.1, 10);
+  if (!(after_lift_s >= 0.1 && after_lift_s <= 10))
+    return OutOfRange(id, "after_lift_s", after_lift_s, 0.1, 10);
   if (!(max_duration_s > led_on_s && max_duration_s <= 120))
     return OutOfRange(id, "max_duration_s", max_duration_s, led_on_s, 120);
-  if (!(noise_sigma >= 0 && noise_sigma <= 30)) return OutOfRange(id, "noise_sigma", noise_sigma, 0, 30);
+  if (!(noise_sigma >= 0 && noise_sigma <= 30))
+    return OutOfRange(id, "noise_sigma", noise_sigma, 0, 30);
   if (!(gain >= 0.2 && gain <= 4)) return OutOfRange(id, "gain", gain, 0.2, 4);
   if (!(flicker_amplitude >= 0 && flicker_amplitude <= 0.5))
     return OutOfRange(id, "flicker_amplitude", flicker_amplitude, 0, 0.5);
-  if (flicker_hz != 100 && flicker_hz != 120) return OutOfRange(id, "flicker_hz (100 or 120)", flicker_hz, 100, 120);
+  if (flicker_hz != 100 && flicker_hz != 120)
+    return OutOfRange(id, "flicker_hz (100 or 120)", flicker_hz, 100, 120);
   if (!(shake_px >= 0 && shake_px <= 2)) return OutOfRange(id, "shake_px", shake_px, 0, 2);
-  if (!(blur_sigma_px >= 0 && blur_sigma_px <= 5)) return OutOfRange(id, "blur_sigma_px", blur_sigma_px, 0, 5);
+  if (!(blur_sigma_px >= 0 && blur_sigma_px <= 5))
+    return OutOfRange(id, "blur_sigma_px", blur_sigma_px, 0, 5);
   if (motion_blur_samples < 1 || motion_blur_samples > 16)
     return OutOfRange(id, "motion_blur_samples", motion_blur_samples, 1, 16);
   VideoWriterOptions writer;
@@ -244,7 +251,9 @@ Status Trial3dSpec::Validate() const {
   return writer.Validate().WithContext("trial3d " + id);
 }
 
-double Motion3d::HeightMAt(double t_video_s) const { return Interpolate(time_s, height_m, t_video_s); }
+double Motion3d::HeightMAt(double t_video_s) const {
+  return Interpolate(time_s, height_m, t_video_s);
+}
 double Motion3d::VertebraRadAt(double t_video_s) const {
   return Interpolate(time_s, vertebra_rad, t_video_s);
 }
@@ -261,7 +270,8 @@ Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec) {
   options.ramp_duration_s = spec.max_rotation_rad / spec.theta_rate_rad_s;
   LIFTOFF_ASSIGN_OR_RETURN(sim::ExperimentResult run, sim::RunExperiment(description, options));
   if (run.status == sim::RunStatus::kDidNotStand) {
-    return NotFoundError("trial3d " + spec.id + ": the simulated robot does not stand: " + run.Brief());
+    return NotFoundError("trial3d " + spec.id +
+                         ": the simulated robot does not stand: " + run.Brief());
   }
   if (run.status == sim::RunStatus::kDiverged) {
     return InvalidArgumentError("trial3d " + spec.id + ": the simulation diverged: " + run.Brief());
@@ -331,14 +341,16 @@ Result<Timing> PlanFrames(const Trial3dSpec& spec, const Motion3d& motion,
       ++dropped_at_led;
       continue;
     }
-    if (timing.pts_ns.empty() || stored_ns > timing.pts_ns.back()) timing.pts_ns.push_back(stored_ns);
+    if (timing.pts_ns.empty() || stored_ns > timing.pts_ns.back())
+      timing.pts_ns.push_back(stored_ns);
   }
   return timing;
 }
 
 // one frame before the effects, CV_32FC3: the scene averaged over the exposure's
 // sub-poses (motion blur), the LED blended by its lit fraction
-cv::Mat BlendLed(SceneRenderer3d& renderer, const std::vector<RobotPose3d>& poses, double fraction) {
+cv::Mat BlendLed(SceneRenderer3d& renderer, const std::vector<RobotPose3d>& poses,
+                 double fraction) {
   const auto average = [&](bool led_on) {
     cv::Mat sum;
     for (const RobotPose3d& pose : poses) {
@@ -405,7 +417,8 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
   const auto within = [&](const std::optional<double>& t) {
     return t && *t < duration_s ? t : std::nullopt;
   };
-  const std::optional<double> t_lift = within(motion.t_lift_s), t_lift_1mm = within(motion.t_lift_1mm_s);
+  const std::optional<double> t_lift = within(motion.t_lift_s),
+                              t_lift_1mm = within(motion.t_lift_1mm_s);
   const bool lifts = t_lift_1mm.has_value();
   json truth;
   truth["id"] = spec.id;
@@ -416,7 +429,8 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
   truth["width"] = width;
   truth["height"] = height;
   truth["nominal_fps"] = spec.fps;
-  truth["timing"] = spec.drop_probability > 0 || spec.drop_frames_at_led > 0 ? (spec.timestamp_jitter_s > 0 ? "jitter_drop" : "drop")
+  truth["timing"] = spec.drop_probability > 0 || spec.drop_frames_at_led > 0
+                        ? (spec.timestamp_jitter_s > 0 ? "jitter_drop" : "drop")
                     : spec.timestamp_jitter_s > 0 ? "jitter"
                                                   : "cfr";
   truth["codec"] = CodecTag(spec.codec);
@@ -464,7 +478,8 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
   truth["pixels_per_mm"] = renderer.PixelsPerMm();
   if (spec.shake_px > 0) {
     json offsets = json::array();
-    for (size_t i = 0; i < pts_ns.size(); ++i) offsets.push_back({Round(shake[i].x, 3), Round(shake[i].y, 3)});
+    for (size_t i = 0; i < pts_ns.size(); ++i)
+      offsets.push_back({Round(shake[i].x, 3), Round(shake[i].y, 3)});
     truth["shake_px"] = offsets;
   } else {
     truth["shake_px"] = nullptr;
@@ -602,8 +617,8 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
     entry.led_roi_px = region(truth["led_roi"]);
     entry.foot_roi_px = region(truth["foot_roi"]);
     entry.px_per_mm = truth["pixels_per_mm"].get<double>();
-    entry.notes = "synthetic 3D (liftoff synth, seed " + std::to_string(spec.seed) + "); truth in " +
-                  spec.id + "/truth.json";
+    entry.notes = "synthetic 3D (liftoff synth, seed " + std::to_string(spec.seed) +
+                  "); truth in " + spec.id + "/truth.json";
     written.manifest_entry = std::move(entry);
   }
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.truth_path, written.truth_json));
@@ -864,8 +879,9 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
     summary.trials.push_back(std::move(*written));
   }
   TrialManifest manifest;
-  manifest.description =
-      description.empty() ? "liftoff synth set " + name + " (" + calibration.name + ")" : description;
+  manifest.description = description.empty()
+                             ? "liftoff synth set " + name + " (" + calibration.name + ")"
+                             : description;
   if (!calibration.source_path.empty()) manifest.calibration_path = calibration.source_path;
   for (const WrittenTrial3d& trial : summary.trials) {
     if (trial.manifest_entry) manifest.trials.push_back(*trial.manifest_entry);

@@ -41,7 +41,8 @@ void AreaResizer::Apply(const cv::Mat& bgr, cv::Mat& out) const {
   std::vector<float> row(static_cast<size_t>(source_.width) * 3);
   for (int oy = 0; oy < output_.height; ++oy) {
     std::fill(row.begin(), row.end(), 0.f);
-    for (int t = y_.begin[static_cast<size_t>(oy)]; t < y_.begin[static_cast<size_t>(oy) + 1]; ++t) {
+    for (int t = y_.begin[static_cast<size_t>(oy)]; t < y_.begin[static_cast<size_t>(oy) + 1];
+         ++t) {
       const Tap& tap = y_.taps[static_cast<size_t>(t)];
       const uint8_t* source = bgr.ptr<uint8_t>(tap.source);
       for (size_t v = 0; v < row.size(); ++v) row[v] += tap.weight * static_cast<float>(source[v]);
@@ -50,7 +51,8 @@ void AreaResizer::Apply(const cv::Mat& bgr, cv::Mat& out) const {
     float* target = out.ptr<float>(oy);
     for (int ox = 0; ox < output_.width; ++ox) {
       float b = 0.f, g = 0.f, r = 0.f;
-      for (int t = x_.begin[static_cast<size_t>(ox)]; t < x_.begin[static_cast<size_t>(ox) + 1]; ++t) {
+      for (int t = x_.begin[static_cast<size_t>(ox)]; t < x_.begin[static_cast<size_t>(ox) + 1];
+           ++t) {
         const Tap& tap = x_.taps[static_cast<size_t>(t)];
         const float* pixel = &row[static_cast<size_t>(tap.source) * 3];
         b += tap.weight * pixel[0];

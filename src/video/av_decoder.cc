@@ -144,7 +144,8 @@ Status AvDecoder::Impl::OpenStream(const std::string& path, int threads) {
   const AVStream* stream = format->streams[stream_index];
   const AVCodec* decoder = avcodec_find_decoder(stream->codecpar->codec_id);
   if (decoder == nullptr) {
-    return ParseError(std::string("no decoder for ") + avcodec_get_name(stream->codecpar->codec_id));
+    return ParseError(std::string("no decoder for ") +
+                      avcodec_get_name(stream->codecpar->codec_id));
   }
   codec = avcodec_alloc_context3(decoder);
   packet = av_packet_alloc();

@@ -543,8 +543,9 @@ class RiseTable {
 
 // Quantile q (0..1, linear between order statistics) of the finite values; NaN for none.
 double FiniteQuantile(std::vector<double>& values, double q) {
-  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-               values.end());
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+      values.end());
   if (values.empty()) return kNaNd;
   std::sort(values.begin(), values.end());
   const double at = q * static_cast<double>(values.size() - 1);
@@ -586,8 +587,9 @@ std::vector<double> RunningMedian(const std::vector<double>& curve, size_t half)
   std::vector<double> window;
   for (size_t i = 0; i < curve.size(); ++i) {
     if (!std::isfinite(curve[i])) continue;
-    window.assign(curve.begin() + static_cast<std::ptrdiff_t>(i >= half ? i - half : 0),
-                  curve.begin() + static_cast<std::ptrdiff_t>(std::min(curve.size(), i + half + 1)));
+    window.assign(
+        curve.begin() + static_cast<std::ptrdiff_t>(i >= half ? i - half : 0),
+        curve.begin() + static_cast<std::ptrdiff_t>(std::min(curve.size(), i + half + 1)));
     out[i] = FiniteMedian(window);
   }
   return out;
@@ -720,7 +722,8 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   const double top = finals[std::min<size_t>(1, finals.size() - 1)].first;
   std::vector<size_t> candidates;
   for (const auto& [final_rise, p] : finals) {
-    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx) candidates.push_back(p);
+    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx)
+      candidates.push_back(p);
   }
   // ... and move with the others, all the way: each candidate's gain against their median
   // curve (least squares over the frames after the rest); a patch that holds some ground or
@@ -960,9 +963,9 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
     // is tracked less well, other jumps are no codec's)
     fit_options.lag_bound = internal::LagBoundPx(height, start, cut, kMinLagPx, kLagBoundFactor);
     if (cut_with_key > cut && cut_with_key + 1 < height.size()) {
-      fit_options.lag_bound = std::max(fit_options.lag_bound,
-                                       internal::LagBoundPx(height, cut_with_key - 2, cut_with_key + 1, kMinLagPx,
-                                                           kLagBoundFactor));
+      fit_options.lag_bound = std::max(
+          fit_options.lag_bound, internal::LagBoundPx(height, cut_with_key - 2, cut_with_key + 1,
+                                                      kMinLagPx, kLagBoundFactor));
     }
     fit_options.lag_weight = kLagWeight;
   }

@@ -14,8 +14,9 @@ double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 }  // namespace
 
 double FiniteMedian(std::vector<double>& values) {
-  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-               values.end());
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+      values.end());
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
 }

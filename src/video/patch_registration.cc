@@ -47,7 +47,8 @@ void AccumulateInside(const PatchTemplate& patch, const cv::Mat& image, const Pa
     const float* r1 = image.ptr<float>(y0 + y + 1) + x0 * channels;
     const int count = patch.width_px * channels;
     for (int i = 0; i < count; ++i, ++k) {
-      const float sample = w00 * r0[i] + w01 * r0[i + channels] + w10 * r1[i] + w11 * r1[i + channels];
+      const float sample =
+          w00 * r0[i] + w01 * r0[i + channels] + w10 * r1[i] + w11 * r1[i + channels];
       const float value = patch.values[k];
       const float w = weighted ? patch.weights[k] : 1.0f;
       const float residual = sample - (gain * value + offset);

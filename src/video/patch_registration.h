@@ -62,7 +62,8 @@ struct PatchMatch {
 
 /// Registers `patch` in `image` (same type as the template's) starting at `guess_px`
 /// (top-left corner). A square patch that leaves the image is not ok; a weighted region's
-/// pixels that leave it are left out. Stops when a step is below `tolerance_px` or after `max_iterations`.
+/// pixels that leave it are left out. Stops when a step is below `tolerance_px` or after
+/// `max_iterations`.
 PatchMatch RegisterPatch(const PatchTemplate& patch, const cv::Mat& image, cv::Point2d guess_px,
                          int max_iterations = 8, double tolerance_px = 0.005);
 

@@ -26,7 +26,8 @@ class EglContext {
   /// Makes the context current on the calling thread again. kUnsupported on failure.
   Status MakeCurrent() const;
 
-  /// "EGL 1.5, Mesa Project, OpenGL 4.5 (Core Profile) Mesa 22.3.6, llvmpipe (LLVM 15.0.6, 256 bits)".
+  /// "EGL 1.5, Mesa Project, OpenGL 4.5 (Core Profile) Mesa 22.3.6, llvmpipe (LLVM 15.0.6, 256
+  /// bits)".
   const std::string& description() const { return description_; }
 
   /// Releases the context and the display.

@@ -97,7 +97,8 @@ class SceneRenderer {
   /// foot_rest_bottom_px() - height_mm * px_per_mm() (the truth tests compare against).
   double FootBottomPxAt(int64_t t_video_ns) const;
   /// Fraction of the exposure of the frame with timestamp t_video_ns (centred on it)
-  /// during which the LED is on, 0 .. 1 (Timeline::LedOnFractionOfExposure, as the truth counts it).
+  /// during which the LED is on, 0 .. 1 (Timeline::LedOnFractionOfExposure, as the truth counts
+  /// it).
   double LedOnFraction(int64_t t_video_ns) const;
   /// Camera shake of frame `frame_index`: the picture's translation, px (x right,
   /// y down); 0 without shake.

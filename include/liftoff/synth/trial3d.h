@@ -18,18 +18,18 @@
 // lifting foot's height h(t) is the simulated marker height above its reference, linear
 // between the 0.01 s samples, with heights below contact_floor_m counted as 0 (on the
 // floor); the vertebra's angle is the simulated hinge angle. The renderer shows h(t) by
-// rolling the lifting foot's end of the robot (scene3d.h). t_lift and t_lift_1mm are the first instants h(t)
-// exceeds 0 and 1 mm (exact on the linear curve).
+// rolling the lifting foot's end of the robot (scene3d.h). t_lift and t_lift_1mm are the first
+// instants h(t) exceeds 0 and 1 mm (exact on the linear curve).
 //
 // Camera. Frame i is presented at pts_i (the frame schedule and container rounding of
 // trial_writer.h's FrameScheduleNs and VideoWriter::StoredPtsNs) and integrates
 // [pts_i - e/2, pts_i + e/2]; it shows the pose at pts_i (or, with motion_blur_samples
-// > 1, the average of the poses at the midpoints of the exposure's equal parts). The LED's lit fraction is the
-// part of that exposure after the switch-on; a partially lit frame is off + f (on - off)
-// of the two rendered pictures (glow included), so it is exact. Then, in this order:
-// flicker (the lamp's 1 + a sin(2 pi f t) averaged over the exposure) times gain, camera
-// shake (a reflected random walk, +-4 px, bilinear), Gaussian blur, Gaussian sensor noise
-// (per-pixel, seeded by (seed, frame)), then the encoder.
+// > 1, the average of the poses at the midpoints of the exposure's equal parts). The LED's lit
+// fraction is the part of that exposure after the switch-on; a partially lit frame is off + f (on -
+// off) of the two rendered pictures (glow included), so it is exact. Then, in this order: flicker
+// (the lamp's 1 + a sin(2 pi f t) averaged over the exposure) times gain, camera shake (a reflected
+// random walk, +-4 px, bilinear), Gaussian blur, Gaussian sensor noise (per-pixel, seeded by (seed,
+// frame)), then the encoder.
 //
 // Everything is a pure function of the spec: the same spec gives the same truth and log
 // bytes, and on one machine the same pixels.

@@ -18,9 +18,9 @@
 //   ffv1   lossless FFV1 in Matroska (packed bgr0: decodes to the input pixels exactly).
 //          FFmpeg's Matroska muxer stores milliseconds: timestamps round to 1 ms.
 // Readers count time from the first frame (liftoff's reader and OpenCV's CAP_PROP_POS_MSEC
-// subtract the stream's start; AVI stores the first frame at slot 0 whatever its time), so the first
-// frame must be stored at 0: then reader times and StoredPtsNs() agree.
-// Output is bit-exact: the same options and frames give the same bytes.
+// subtract the stream's start; AVI stores the first frame at slot 0 whatever its time), so the
+// first frame must be stored at 0: then reader times and StoredPtsNs() agree. Output is bit-exact:
+// the same options and frames give the same bytes.
 #pragma once
 
 #include <cstdint>

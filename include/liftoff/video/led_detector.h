@@ -17,13 +17,13 @@
 //
 // With an ROI the detector works on the ROI's pixels, so a 1 px LED in a region hundreds of
 // times its size is found: each pixel's B + G + R against its own reference (an average of
-// the frames that left a ring of the last 5 + min_on_frames, so a step is measured against frames before
-// it), each row's flicker gain taken out first (measured on the same rows beside the ROI, in
+// the frames that left a ring of the last 5 + min_on_frames, so a step is measured against frames
+// before it), each row's flicker gain taken out first (measured on the same rows beside the ROI, in
 // bands of 4 rows, interpolated: rolling-shutter banding), the ROI's outer 3 px left out
-// (shake carries what lies just outside into them). The signal is the sum of the largest increases (a 256th of the
-// ROI's pixels, at least 9) plus the largest decreases. Around a step the ROI's pixels that
-// stepped clearly are the LED's: no light when pixels stepping the other way add up to half
-// as much (an edge moved by shake or a passing part) or when they do not hold their levels;
+// (shake carries what lies just outside into them). The signal is the sum of the largest increases
+// (a 256th of the ROI's pixels, at least 9) plus the largest decreases. Around a step the ROI's
+// pixels that stepped clearly are the LED's: no light when pixels stepping the other way add up to
+// half as much (an edge moved by shake or a passing part) or when they do not hold their levels;
 // the dating sums those that do not clip when lit (all of them, marked clipped, when those
 // carry less than a quarter of the step: then only the upper bound of f holds, as a clipped
 // core reaches 255 even in a partly lit frame). The fraction is known to within 3 sigmas of
@@ -47,11 +47,11 @@
 // the rest of the frame did at that instant (codec key frames, lighting changes and shake
 // step many regions at once; with an ROI, a step whose largest pixel step is 4 times the
 // ROI's usual one stands out however the frame changed), and the signal then holds its
-// new level (with an ROI, or goes on rising), or returns to the old one, for 8 more frames. A region's steps under half the contrast of its brightest
-// switch-on are not pulses. Limits: in an ROI where no LED ever lights, a codec's update of
-// a still block by a few grey levels can pass for a dim LED; a small, dim LED under strong
-// camera shake is missed rather than mistaken; located, a 1 px LED under flicker and shake
-// loses to larger steps.
+// new level (with an ROI, or goes on rising), or returns to the old one, for 8 more frames. A
+// region's steps under half the contrast of its brightest switch-on are not pulses. Limits: in an
+// ROI where no LED ever lights, a codec's update of a still block by a few grey levels can pass for
+// a dim LED; a small, dim LED under strong camera shake is missed rather than mistaken; located, a
+// 1 px LED under flicker and shake loses to larger steps.
 #pragma once
 
 #include <cstdint>

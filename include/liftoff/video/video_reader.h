@@ -3,8 +3,8 @@
 // it also reports). Nominal frame rate and the container's frame count are never trusted
 // (both lie for variable-frame-rate files): each frame's time is the decoder's
 // presentation time, checked; a time that is missing or does not increase is extrapolated
-// from the median interval and marked (Frame::t_repaired). Dropped and irregular frames are reported in
-// FrameTimingReport. Memory stays flat: one frame buffer, a few dozen intervals and a
+// from the median interval and marked (Frame::t_repaired). Dropped and irregular frames are
+// reported in FrameTimingReport. Memory stays flat: one frame buffer, a few dozen intervals and a
 // fixed histogram.
 #pragma once
 
