@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr std::string_view kShardFormat = "liftoff-report-shard";
-constexpr int kShardVersion = 1;
+constexpr int kShardVersion = 2;  // 2: LED pulses carry missing_frames_before_on
 
 // ---------------------------------------------------------------------------------------
 // values: numbers that may be NaN (JSON null), optionals, rectangles, statuses

@@ -32,14 +32,17 @@ using internal::PatchTemplate;
 using internal::RectText;
 
 // The work image: the foot region and a margin of this fraction of its size on every side
-// (static ground for the camera's shake), scaled down so that the region's smaller side is
-// at most kWorkRegionPx (registration keeps its sub-pixel precision; large regions cost
-// no more than small ones).
+// (static ground for the camera's shake), scaled so that the region's smaller side is
+// kWorkRegionPx: down from larger (registration keeps its sub-pixel precision; large
+// regions cost no more than small ones), up from under kEnlargeBelowPx (a small foot still
+// holds several patches); 48 .. 64 px stay as they are. Enlarged, the larger side stays
+// under kWorkLargestPx (a thin region).
 constexpr double kMarginFraction = 0.3;
 constexpr double kWorkRegionPx = 64.0;
 // A region whose smaller side is under this is enlarged to kWorkRegionPx (at 48 rather
 // than 32, the dev set at half size had d05 at +0.0012 rad instead of -0.0068).
 constexpr int kEnlargeBelowPx = 48;
+constexpr double kWorkLargestPx = 256.0;
 // Patch side in work px, and the spacing of candidate patches.
 constexpr int kPatchPx = 9;
 constexpr int kPatchStridePx = 3;
@@ -271,8 +274,10 @@ void FootTracker::Impl::ChooseWorkRegion(const cv::Size& size) {
   // "never lifts" at its own size, -0.0026 rad enlarged; hard3d-04 at seed 3000, -0.0151
   // rad in a 24 px region, -0.0004 enlarged)
   const int smaller = std::min(roi.width, roi.height);
-  scale = smaller < kEnlargeBelowPx ? kWorkRegionPx / smaller
-                                    : std::min(1.0, kWorkRegionPx / smaller);
+  const int larger = std::max(roi.width, roi.height);
+  scale = smaller < kEnlargeBelowPx
+              ? std::max(1.0, std::min(kWorkRegionPx / smaller, kWorkLargestPx / larger))
+              : std::min(1.0, kWorkRegionPx / smaller);
   if (scale < 1) resizer = internal::AreaResizer(work_px.size(), scale);
   const auto to_work = [&](int v, int origin) {
     return static_cast<int>(std::lround((v - origin) * scale));

@@ -107,7 +107,9 @@ inline InstantInterval SwitchOnInterval(double t_dark_ns, LitFraction dark, doub
 struct SwitchOnDating {
   InstantInterval surely;
   double estimate_ns = 0.0;
-  int missing_frames = 0;  // frames missing between the dark and the lit frame
+  // frames missing between the dark and the lit frame, when the estimate took the first
+  // of them as the first lit (0 otherwise, a partly lit frame dating the switch itself)
+  int missing_frames = 0;
   // the half-width of the narrowest interval centred on the estimate that holds `surely`
   int64_t HalfWidth() const {
     return static_cast<int64_t>(std::ceil(std::min(
@@ -123,8 +125,8 @@ inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_
   if (!(period_ns > 0.0) || t_lit_ns - t_dark_ns <= 1.5 * period_ns) return dating;
   // (bounded: a gap of hours between two frames must not overflow the count)
   const double intervals = std::min(std::round((t_lit_ns - t_dark_ns) / period_ns), 1e9);
-  dating.missing_frames = static_cast<int>(intervals) - 1;
   if (lit.high < 1.0) return dating;
+  dating.missing_frames = static_cast<int>(intervals) - 1;
   const InstantInterval first_missing =
       SwitchOnInterval(t_dark_ns, dark, t_dark_ns + period_ns, {0.0, 1.0}, exposure);
   dating.estimate_ns = std::clamp(0.5 * (first_missing.low_ns + first_missing.high_ns),

@@ -78,10 +78,10 @@ struct LedPulse {
   /// exposure during which it was on (1: it switched on between two exposures).
   int64_t first_lit_frame = 0;
   double first_lit_fraction = 1.0;
-  /// Frames missing between the last dark frame and the first lit one (by the usual
-  /// frame interval); when > 0 and the first lit frame was fully lit, on_ns takes the
-  /// first missing frame as the one that saw the switch-on, and on_uncertainty_ns still
-  /// covers the whole gap.
+  /// Frames missing between the last dark frame and a fully lit first one (by the usual
+  /// frame interval): on_ns then takes the first missing frame as the one that saw the
+  /// switch-on, and on_uncertainty_ns still covers the whole gap. 0 without a gap, or
+  /// when a partly lit first frame dates the switch-on itself.
   int missing_frames_before_on = 0;
   /// Switch-off instant, ns, when the LED went off again within the clip.
   std::optional<int64_t> off_ns;
