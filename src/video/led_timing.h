@@ -122,10 +122,10 @@ inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_
   SwitchOnDating dating;
   dating.surely = SwitchOnInterval(t_dark_ns, dark, t_lit_ns, lit, exposure);
   dating.estimate_ns = 0.5 * (dating.surely.low_ns + dating.surely.high_ns);
-  if (!(period_ns > 0.0) || t_lit_ns - t_dark_ns <= 1.5 * period_ns) return dating;
+  const bool gap = period_ns > 0.0 && t_lit_ns - t_dark_ns > 1.5 * period_ns;
+  if (!gap || lit.high < 1.0) return dating;
   // (bounded: a gap of hours between two frames must not overflow the count)
   const double intervals = std::min(std::round((t_lit_ns - t_dark_ns) / period_ns), 1e9);
-  if (lit.high < 1.0) return dating;
   dating.missing_frames = static_cast<int>(intervals) - 1;
   const InstantInterval first_missing =
       SwitchOnInterval(t_dark_ns, dark, t_dark_ns + period_ns, {0.0, 1.0}, exposure);

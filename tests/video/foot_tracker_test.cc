@@ -338,24 +338,29 @@ TEST(FootTracker, APartMovedByTheBendAndLostLongBeforeTheLiftoffIsNoFoot) {
   ExpectDrawnLiftoff(DrawnOptions(cv::Rect(70, 50, 60, 52)), 300, draw, 8.0 + std::sqrt(0.005));
 }
 
-TEST(FootTracker, AStillFootAKeyFrameMovedThreeThresholdsIsNoLift) {
-  // hand-drawn as H.264 shows a still foot (shared/video-dev's d12 encoded again by
-  // OpenCV's H.264 writer): a key frame every 2 s, the frames between copy it; the key frame at 6 s
-  // renews the picture with the foot's edge 1.5 px (3 thresholds) higher, and it stays
-  // there to the end, 4 s on. A lift goes on rising: this is none.
+// A still foot as H.264 shows it (shared/video-dev's d12 encoded again by OpenCV's H.264
+// writer): a key frame every 2 s, the frames between copy it; the key frame at 6 s renews
+// the picture with the foot's edge `step_px` higher, and it stays there to the end, 4 s on.
+// Tracked through a lossy codec with `threshold_px`.
+Result<FootTrack> TrackStillFootAKeyFrameMoved(double step_px, double threshold_px) {
   const cv::Size size(200, 150);
   const cv::Mat floor = Texture(size, 10, 90, 200), foot = Texture(size, 11, 0, 60);
   cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
   cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
   const auto draw = [&](double t_s) {
-    const double shown_px = t_s >= 6.0 - 1e-6 ? 1.5 : 0.0;
+    const double shown_px = t_s >= 6.0 - 1e-6 ? step_px : 0.0;
     const cv::Mat f = ShiftedUp(foot_mask, shown_px);
     return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px).mul(f));
   };
   FootTracker::Options options = DrawnOptions(cv::Rect(75, 55, 50, 50));
+  options.threshold_px = threshold_px;
   options.compression_error_px = 0.2;  // a lossy codec
-  const Result<FootTrack> track =
-      TrackDrawn(options, 300, draw, [](int64_t index) { return index % 60 == 0; });
+  return TrackDrawn(options, 300, draw, [](int64_t index) { return index % 60 == 0; });
+}
+
+TEST(FootTracker, AStillFootAKeyFrameMovedThreeThresholdsIsNoLift) {
+  // 1.5 px, 3 thresholds of 0.5 px: a lift goes on rising, this is none
+  const Result<FootTrack> track = TrackStillFootAKeyFrameMoved(1.5, 0.5);
   ASSERT_FALSE(track.ok()) << track->Brief();
   EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
   EXPECT_NE(track.status().message().find("the foot never lifts"), std::string::npos)
@@ -365,24 +370,10 @@ TEST(FootTracker, AStillFootAKeyFrameMovedThreeThresholdsIsNoLift) {
 }
 
 TEST(FootTracker, ASmallRobotsStillFootAKeyFrameMovedUnderTwoPxIsNoLift) {
-  // the same still foot of a small robot (a 0.2 px threshold: 1 mm at 0.2 px a mm, d12 of
-  // shared/video-dev at half size): the key frame at 6 s moves its edge 1.2 px, six
-  // thresholds, and it stays there. Four thresholds are not enough here: under 2 px is no
-  // lift through a lossy codec.
-  const cv::Size size(200, 150);
-  const cv::Mat floor = Texture(size, 10, 90, 200), foot = Texture(size, 11, 0, 60);
-  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
-  cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
-  const auto draw = [&](double t_s) {
-    const double shown_px = t_s >= 6.0 - 1e-6 ? 1.2 : 0.0;
-    const cv::Mat f = ShiftedUp(foot_mask, shown_px);
-    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px).mul(f));
-  };
-  FootTracker::Options options = DrawnOptions(cv::Rect(75, 55, 50, 50));
-  options.threshold_px = 0.2;
-  options.compression_error_px = 0.2;  // a lossy codec
-  const Result<FootTrack> track =
-      TrackDrawn(options, 300, draw, [](int64_t index) { return index % 60 == 0; });
+  // a small robot's (a 0.2 px threshold: 1 mm at 0.2 px a mm, d12 of shared/video-dev at
+  // half size): 1.2 px, six thresholds. Four thresholds are not enough here: under 2 px is
+  // no lift through a lossy codec.
+  const Result<FootTrack> track = TrackStillFootAKeyFrameMoved(1.2, 0.2);
   ASSERT_FALSE(track.ok()) << track->Brief();
   EXPECT_EQ(track.status().code(), StatusCode::kNotFound);
   EXPECT_NE(track.status().message().find("under 2.00 px"), std::string::npos)

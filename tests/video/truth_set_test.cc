@@ -125,11 +125,17 @@ std::vector<ClipScore> ScoreFolder(const fs::path& root) {
   return scores;
 }
 
+// The rotation targets: every ok clip within `every_clip_rad`, at least `share_within_5mrad`
+// of them within 0.005 rad (the issue's: 0.01 rad, 90 %).
+struct RotationTargets {
+  double every_clip_rad = 0.01;
+  double share_within_5mrad = 0.9;
+};
+
 // The targets of the issue, asserted per clip and over the set: the rejects not found; on
-// every ok clip the LED within half a frame and the truth inside the interval; with
-// `rotation_targets`, the rotation within 0.01 rad in every ok clip and within 0.005 rad in
-// at least 90 % of them. Returns the number of ok clips.
-size_t ExpectTargets(const std::vector<ClipScore>& scores, bool rotation_targets) {
+// every ok clip the LED within half a frame and the truth inside the interval; the
+// rotation targets. Returns the number of ok clips.
+size_t ExpectTargets(const std::vector<ClipScore>& scores, RotationTargets targets = {}) {
   size_t ok_clips = 0, within_5mrad = 0, within_10mrad = 0;
   for (const ClipScore& s : scores) {
     if (!s.expect_ok) {
@@ -142,16 +148,15 @@ size_t ExpectTargets(const std::vector<ClipScore>& scores, bool rotation_targets
     EXPECT_LE(std::abs(s.led_error_frames), 0.5) << s.id;
     EXPECT_TRUE(s.truth_inside) << s.id << ": error " << s.liftoff_error_ms << " ms, +- "
                                 << s.interval_uncertainty_ms << " ms";
-    if (rotation_targets) {
-      EXPECT_LE(std::abs(s.rotation_error_rad), 0.01) << s.id;
-    }
+    EXPECT_LE(std::abs(s.rotation_error_rad), targets.every_clip_rad) << s.id;
     if (std::abs(s.rotation_error_rad) <= 0.005) ++within_5mrad;
     if (std::abs(s.rotation_error_rad) <= 0.01) ++within_10mrad;
   }
   std::printf("%zu of %zu ok clips within 0.005 rad, %zu within 0.01 rad\n", within_5mrad,
               ok_clips, within_10mrad);
-  if (rotation_targets && ok_clips > 0) {
-    EXPECT_GE(static_cast<double>(within_5mrad), 0.9 * static_cast<double>(ok_clips))
+  if (ok_clips > 0) {
+    EXPECT_GE(static_cast<double>(within_5mrad),
+              targets.share_within_5mrad * static_cast<double>(ok_clips))
         << within_5mrad << " of " << ok_clips << " clips within 0.005 rad";
   }
   return ok_clips;
@@ -172,7 +177,7 @@ TEST(Video3dCiSet, EveryClipMeetsTheTargets) {
   const fs::path root = LIFTOFF_CI3D_SET_DIR;
   if (!fs::exists(root / "set.json")) GTEST_SKIP() << root << " was not rendered (no headless GL)";
   const std::vector<ClipScore> scores = ScoreFolder(root);
-  const size_t ok_clips = ExpectTargets(scores, /*rotation_targets=*/true);
+  const size_t ok_clips = ExpectTargets(scores);
   EXPECT_EQ(ok_clips, 8u);
   const ClipScore* led_never_on = Find(scores, "ci3d-09");
   const ClipScore* never_lifts = Find(scores, "ci3d-10");
@@ -187,7 +192,7 @@ TEST(VideoDevSet, EveryClipMeetsTheTargets) {
   const fs::path root = fs::path(LIFTOFF_SHARED_DIR) / "video-dev";
   if (!fs::exists(root)) GTEST_SKIP() << root << " is absent (a fresh clone has no ../shared)";
   const std::vector<ClipScore> scores = ScoreFolder(root);
-  EXPECT_EQ(ExpectTargets(scores, /*rotation_targets=*/true), 11u);
+  EXPECT_EQ(ExpectTargets(scores), 11u);
   // the two reject clips, each with its own error
   const ClipScore* led_never_on = Find(scores, "d11");
   const ClipScore* never_lifts = Find(scores, "d12");
@@ -206,18 +211,18 @@ TEST(VideoDevSet, EveryClipMeetsTheTargets) {
 // within half a frame and the truth inside its interval, every rotation within 0.015 rad
 // and 8 of the 10 within 0.005 rad (measured: 8 within 0.005, 9 within 0.01, the largest
 // d01's 0.0128).
-fs::path WriteHalfSizeClip(const fs::path& from, const fs::path& to) {
-  std::ifstream in(from / "truth.json");
-  nlohmann::json truth = nlohmann::json::parse(in);
+// Writes the clip in `from` (its truth given) at half size into `to`; false where OpenCV
+// cannot write H.264.
+bool WriteHalfSizeClip(const fs::path& from, nlohmann::json truth, const fs::path& to) {
   cv::VideoCapture capture((from / truth.at("video").get<std::string>()).string(), cv::CAP_FFMPEG);
   cv::Mat frame, half;
-  if (!capture.read(frame)) return {};
+  if (!capture.read(frame)) return false;
   fs::create_directories(to);
   cv::VideoWriter writer((to / "video.mp4").string(), cv::CAP_FFMPEG,
                          cv::VideoWriter::fourcc('a', 'v', 'c', '1'),
                          truth.at("nominal_fps").get<double>(),
                          cv::Size(frame.cols / 2, frame.rows / 2));
-  if (!writer.isOpened()) return {};
+  if (!writer.isOpened()) return false;
   do {
     cv::resize(frame, half, cv::Size(frame.cols / 2, frame.rows / 2), 0, 0, cv::INTER_AREA);
     writer.write(half);
@@ -236,7 +241,7 @@ fs::path WriteHalfSizeClip(const fs::path& from, const fs::path& to) {
   std::printf("%s at half size: %.2f px a mm, foot region %dx%d px\n",
               from.filename().string().c_str(), truth.at("pixels_per_mm").get<double>(),
               truth.at("foot_roi").at(2).get<int>(), truth.at("foot_roi").at(3).get<int>());
-  return to;
+  return true;
 }
 
 TEST(VideoDevSetAtHalfSize, EveryClipMeetsTheSmallRobotTargets) {
@@ -247,28 +252,16 @@ TEST(VideoDevSetAtHalfSize, EveryClipMeetsTheSmallRobotTargets) {
   for (const fs::directory_entry& entry : fs::directory_iterator(root)) {
     if (!fs::exists(entry.path() / "truth.json")) continue;
     std::ifstream in(entry.path() / "truth.json");
+    const nlohmann::json truth = nlohmann::json::parse(in);
     // the writer keeps a constant rate: the variable-rate clip stays out
-    if (nlohmann::json::parse(in).at("timing").get<std::string>() != "cfr") continue;
-    if (WriteHalfSizeClip(entry.path(), half / entry.path().filename()).empty()) {
+    if (truth.at("timing").get<std::string>() != "cfr") continue;
+    if (!WriteHalfSizeClip(entry.path(), truth, half / entry.path().filename())) {
       GTEST_SKIP() << entry.path() << ": OpenCV's H.264 writer is not available here";
     }
   }
-  const std::vector<ClipScore> scores = ScoreFolder(half);
-  size_t ok_clips = 0, within_5mrad = 0;
-  for (const ClipScore& s : scores) {
-    if (!s.expect_ok) {
-      EXPECT_EQ(s.status.code(), StatusCode::kNotFound) << s.id << ": " << s.status.ToString();
-      continue;
-    }
-    ASSERT_TRUE(s.status.ok()) << s.id << ": " << s.status.ToString();
-    ++ok_clips;
-    EXPECT_LE(std::abs(s.led_error_frames), 0.5) << s.id;
-    EXPECT_TRUE(s.truth_inside) << s.id;
-    EXPECT_LE(std::abs(s.rotation_error_rad), 0.015) << s.id;
-    if (std::abs(s.rotation_error_rad) <= 0.005) ++within_5mrad;
-  }
-  EXPECT_EQ(ok_clips, 10u);
-  EXPECT_GE(within_5mrad, 8u);
+  // every ok clip measured (10), within 0.015 rad, 8 of 10 within 0.005 rad
+  EXPECT_EQ(ExpectTargets(ScoreFolder(half), {.every_clip_rad = 0.015, .share_within_5mrad = 0.8}),
+            10u);
 }
 
 // Any folder of clips in the same format, such as `liftoff synth --set hard3d -o DIR`:
@@ -276,7 +269,7 @@ TEST(VideoDevSetAtHalfSize, EveryClipMeetsTheSmallRobotTargets) {
 TEST(AnyTruthSet, EveryClipMeetsTheTargets) {
   const char* dir = std::getenv("LIFTOFF_TRUTH_SET_DIR");
   if (dir == nullptr || *dir == '\0') GTEST_SKIP() << "LIFTOFF_TRUTH_SET_DIR is not set";
-  ExpectTargets(ScoreFolder(dir), /*rotation_targets=*/true);
+  ExpectTargets(ScoreFolder(dir));
 }
 #endif
 
