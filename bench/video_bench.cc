@@ -3,19 +3,22 @@
 // CAP_PROP_POS_MSEC, nothing else: what reading a clip costs an OpenCV program) against the
 // full analysis (video::AnalyzeClip: LED and foot, decoding with FFmpeg's libraries on a
 // second thread and converting only the regions the detectors read to BGR), and the ratio
-// (target: at most 1.2); the full
-// analysis on one thread too, for comparison. Then peak memory: a plain decode and the
-// analysis of a 1080p clip and of one three times longer, each in a child process of its
-// own, and their peak resident set sizes (each child's VmHWM, which starts at its exec:
-// a forked child's ru_maxrss also counts the parent's pages resident at the fork, which
-// after the timings above are more than either child's): the analysis' must not grow with
-// length.
+// (target: at most 1.2); the full analysis on one thread too, for comparison. The three run
+// in turn, 15 rounds of one each: a round's ratios compare runs a second apart, and the
+// medians over the rounds are the figures (blocks of 15 runs of one kind, then of the
+// other, moved the 720p ratio across the target from one run of the bench to the next, as
+// the machine's speed drifted). Then peak memory: a plain decode and the analysis of a 1080p
+// clip and of one three times longer, each in a child process of its own, and their peak
+// resident set sizes (each child's VmHWM, which starts at its exec: a forked child's
+// ru_maxrss also counts the parent's pages resident at the fork, which after the timings
+// above are more than either child's): the analysis' must not grow with length.
 //
 // The clips are rendered by synth at startup into a temporary folder (removed at exit):
-// 4 s at 30 fps (the LED at 0.5 s, the foot 1 mm up near 3 s), and a 12 s 1080p clip with
-// a slower ramp for the memory figure.
+// 4 s at 30 fps (the LED at 0.5 s, the foot 1 mm up near 3 s), and a 12 s 1080p clip that
+// rests 8 s longer before the same ramp, for the memory figure.
 //
-// Run: build/bench/video_bench   (the table at the end is the figure to quote)
+// Run: build/bench/video_bench   (the table at the end is the figure to quote; a failed
+// analysis is printed as such and exits non-zero)
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -32,7 +35,9 @@
 #include <opencv2/videoio.hpp>
 
 #include "bench_support.h"
+#include "liftoff/core/status.h"
 #include "liftoff/core/time.h"
+#include "liftoff/stats/statistics.h"
 #include "liftoff/synth/spec.h"
 #include "liftoff/synth/trial_writer.h"
 #include "liftoff/video/clip_analysis.h"
@@ -50,12 +55,18 @@ struct BenchClip {
 
 std::filesystem::path g_dir;
 std::map<std::string, BenchClip> g_clips;
-// ms per frame of each benchmark, by its name
-std::map<std::string, double> g_ms_per_frame;
+// per size, each round's ms per frame: plain decode, full analysis, on one thread
+struct Rounds {
+  std::vector<double> plain, full, single;
+};
+std::map<std::string, Rounds> g_rounds;
 
-// The clip: `width` x `height`, 30 fps, H.264; the ramp chosen so the 1 mm instant falls
-// 1 s before the end.
+// The clip: `width` x `height`, 30 fps, H.264; the ramp chosen so that in a 4 s clip the
+// 1 mm instant falls 1 s before the end. A longer clip rests longer before the same ramp
+// (a slower ramp would leave the foot, 1 s after the 1 mm instant, under the rise a lift
+// must reach, and the analysis would fail).
 synth::TrialSpec BenchSpec(const std::string& id, int width_px, int height_px, double duration_s) {
+  constexpr double kRampedS = 4.0;
   synth::TrialSpec spec;
   spec.id = id;
   spec.seed = 11;
@@ -69,10 +80,10 @@ synth::TrialSpec BenchSpec(const std::string& id, int width_px, int height_px, d
   spec.led.on_video_s = 0.5;
   spec.motion.bend_start_s = 0.0;
   spec.motion.bend_end_s = 0.15;
-  spec.motion.ramp_start_s = 0.2;
+  spec.motion.ramp_start_s = 0.2 + (duration_s - kRampedS);
   spec.motion.height.liftoff_rad = 0.3;
   const double one_mm_rad = 0.3 + std::pow(0.001 / spec.motion.height.gain_m, 1.0 / 1.5);
-  spec.motion.ramp_rate_rad_per_s = one_mm_rad / (duration_s - 1.0 - 0.7);
+  spec.motion.ramp_rate_rad_per_s = one_mm_rad / (kRampedS - 1.0 - 0.7);
   return spec;
 }
 
@@ -86,46 +97,52 @@ video::ClipAnalysisOptions OptionsFor(const BenchClip& clip, int queue_frames) {
   return options;
 }
 
-void Record(benchmark::State& state, const std::string& name, int64_t elapsed_ns, int64_t frames) {
-  const double ms = 1e-6 * static_cast<double>(elapsed_ns) / static_cast<double>(frames);
-  g_ms_per_frame[name] = ms;
-  state.counters["ms_per_frame"] = ms;
-  state.counters["frames"] = static_cast<double>(frames);
-}
-
-// the baseline: read every frame and its time, nothing else
-void BM_PlainDecode(benchmark::State& state, const std::string& clip_name) {
-  const BenchClip& clip = g_clips.at(clip_name);
-  int64_t frames = 0;
+// wall ms per frame of a plain decode of `clip` (-1 when it read nothing)
+double PlainDecodeMs(const BenchClip& clip) {
   const int64_t started_ns = MonotonicNowNs();
-  for (auto _ : state) {
-    cv::VideoCapture capture(clip.trial.video_path.string(), cv::CAP_FFMPEG);
-    cv::Mat frame;
-    double last_ms = 0.0;
-    while (capture.read(frame)) {
-      last_ms = capture.get(cv::CAP_PROP_POS_MSEC);
-      ++frames;
-    }
-    benchmark::DoNotOptimize(last_ms);
+  cv::VideoCapture capture(clip.trial.video_path.string(), cv::CAP_FFMPEG);
+  cv::Mat frame;
+  double last_ms = 0.0;
+  int64_t frames = 0;
+  while (capture.read(frame)) {
+    last_ms = capture.get(cv::CAP_PROP_POS_MSEC);
+    ++frames;
   }
-  Record(state, "plain " + clip_name, MonotonicNowNs() - started_ns, frames);
+  benchmark::DoNotOptimize(last_ms);
+  if (frames == 0) return -1;
+  return 1e-6 * static_cast<double>(MonotonicNowNs() - started_ns) / static_cast<double>(frames);
 }
 
-void BM_FullAnalysis(benchmark::State& state, const std::string& clip_name, int queue_frames) {
-  const BenchClip& clip = g_clips.at(clip_name);
-  const video::ClipAnalysisOptions options = OptionsFor(clip, queue_frames);
-  int64_t frames = 0;
+// wall ms per frame of the full analysis of `clip`, or its error
+Result<double> FullAnalysisMs(const BenchClip& clip, int queue_frames) {
   const int64_t started_ns = MonotonicNowNs();
+  auto analysis = video::AnalyzeClip(clip.trial.video_path, OptionsFor(clip, queue_frames));
+  if (!analysis.ok()) return analysis.status();
+  return 1e-6 * static_cast<double>(MonotonicNowNs() - started_ns) /
+         static_cast<double>(analysis->timing.frames);
+}
+
+// one round per iteration: a plain decode, the analysis, the analysis on one thread
+void BM_Rounds(benchmark::State& state, const std::string& clip_name) {
+  const BenchClip& clip = g_clips.at(clip_name);
+  Rounds& rounds = g_rounds[clip_name];
   for (auto _ : state) {
-    auto analysis = video::AnalyzeClip(clip.trial.video_path, options);
-    if (!analysis.ok()) {
-      state.SkipWithError(analysis.status().ToString().c_str());
+    const double plain = PlainDecodeMs(clip);
+    const Result<double> full = FullAnalysisMs(clip, 3);
+    const Result<double> single = FullAnalysisMs(clip, 0);
+    if (plain < 0 || !full.ok() || !single.ok()) {
+      const Status failed = plain < 0 ? NotFoundError("the plain decode read no frame")
+                                      : (!full.ok() ? full.status() : single.status());
+      state.SkipWithError(failed.ToString().c_str());
+      rounds = {};
       return;
     }
-    frames += analysis->timing.frames;
+    rounds.plain.push_back(plain);
+    rounds.full.push_back(*full);
+    rounds.single.push_back(*single);
   }
-  Record(state, (queue_frames > 0 ? "full " : "full-1thread ") + clip_name,
-         MonotonicNowNs() - started_ns, frames);
+  state.counters["plain_ms_per_frame"] = stats::Summarize(rounds.plain).median;
+  state.counters["full_ms_per_frame"] = stats::Summarize(rounds.full).median;
 }
 
 // child mode: decode one clip plainly and exit (the parent reads our peak memory)
@@ -215,18 +232,9 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  // plain and full side by side at each size (same clip, interleaved)
+  // plain and full in turn at each size (same clip), 15 rounds
   for (const std::string size : {"720p", "1080p"}) {
-    benchmark::RegisterBenchmark(("PlainDecode/" + size).c_str(), BM_PlainDecode, size)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime()
-        ->Iterations(15);
-    benchmark::RegisterBenchmark(("FullAnalysis/" + size).c_str(), BM_FullAnalysis, size, 3)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime()
-        ->Iterations(15);
-    benchmark::RegisterBenchmark(("FullAnalysisOneThread/" + size).c_str(), BM_FullAnalysis, size,
-                                 0)
+    benchmark::RegisterBenchmark(("Rounds/" + size).c_str(), BM_Rounds, size)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime()
         ->Iterations(15);
@@ -235,16 +243,30 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
 
-  // the figures, side by side
-  std::printf("\nvideo analysis vs plain decode (H.264, 30 fps, wall time per frame):\n");
-  std::printf("%-6s %10s %12s %8s %14s %8s\n", "size", "plain ms", "full ms", "ratio",
-              "1 thread ms", "ratio");
+  // the figures: medians over the rounds, and each round's ratio's range
+  int exit_code = 0;
+  std::printf("\nvideo analysis vs plain decode (H.264, 30 fps, wall ms per frame; medians of "
+              "15 rounds):\n");
+  std::printf("%-6s %9s %8s %7s %13s %9s %7s %13s\n", "size", "plain ms", "full ms", "ratio",
+              "ratio range", "1 thr ms", "ratio", "ratio range");
   for (const std::string size : {"720p", "1080p"}) {
-    const double plain = g_ms_per_frame["plain " + size];
-    const double full = g_ms_per_frame["full " + size];
-    const double single = g_ms_per_frame["full-1thread " + size];
-    std::printf("%-6s %10.2f %12.2f %8.2f %14.2f %8.2f\n", size.c_str(), plain, full,
-                plain > 0 ? full / plain : 0.0, single, plain > 0 ? single / plain : 0.0);
+    const Rounds& rounds = g_rounds[size];
+    if (rounds.plain.empty()) {
+      std::printf("%-6s failed: its rounds stopped with an error (above)\n", size.c_str());
+      exit_code = 1;
+      continue;
+    }
+    std::vector<double> full_ratio, single_ratio;
+    for (size_t i = 0; i < rounds.plain.size(); ++i) {
+      full_ratio.push_back(rounds.full[i] / rounds.plain[i]);
+      single_ratio.push_back(rounds.single[i] / rounds.plain[i]);
+    }
+    const stats::Summary full = stats::Summarize(full_ratio);
+    const stats::Summary single = stats::Summarize(single_ratio);
+    std::printf("%-6s %9.2f %8.2f %7.2f %6.2f-%-6.2f %9.2f %7.2f %6.2f-%-6.2f\n", size.c_str(),
+                stats::Summarize(rounds.plain).median, stats::Summarize(rounds.full).median,
+                full.median, full.min, full.max, stats::Summarize(rounds.single).median,
+                single.median, single.min, single.max);
   }
   std::printf("\npeak memory (VmHWM of a child process, 1080p):\n");
   std::printf("%-10s %14s %14s %12s\n", "frames", "plain decode", "full analysis", "difference");
@@ -252,6 +274,12 @@ int main(int argc, char** argv) {
     const BenchClip& clip = g_clips.at(name);
     const long decode_kib = ChildPeakKib(argv[0], clip, true);
     const long analyse_kib = ChildPeakKib(argv[0], clip, false);
+    if (decode_kib < 0 || analyse_kib < 0) {
+      std::printf("%-10lld failed: the %s child reported no peak memory\n",
+                  static_cast<long long>(clip.frames), decode_kib < 0 ? "decode" : "analysis");
+      exit_code = 1;
+      continue;
+    }
     std::printf("%-10lld %10.1f MiB %10.1f MiB %8.1f MiB\n", static_cast<long long>(clip.frames),
                 static_cast<double>(decode_kib) / 1024.0, static_cast<double>(analyse_kib) / 1024.0,
                 static_cast<double>(analyse_kib - decode_kib) / 1024.0);
@@ -259,5 +287,5 @@ int main(int argc, char** argv) {
 
   std::error_code ignored;
   std::filesystem::remove_all(g_dir, ignored);
-  return 0;
+  return exit_code;
 }

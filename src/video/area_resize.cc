@@ -61,9 +61,10 @@ void AreaResizer::Apply(const cv::Mat& bgr, cv::Mat& out) const {
       }
       // to whole levels, half to even, as cv::resize gives an 8-bit image's at a
       // non-integer scale (the tracker was tuned on those)
-      target[3 * ox] = std::nearbyint(b);
-      target[3 * ox + 1] = std::nearbyint(g);
-      target[3 * ox + 2] = std::nearbyint(r);
+      // (cvRound: inline, where std::nearbyint is a library call per channel)
+      target[3 * ox] = static_cast<float>(cvRound(b));
+      target[3 * ox + 1] = static_cast<float>(cvRound(g));
+      target[3 * ox + 2] = static_cast<float>(cvRound(r));
     }
   }
 }

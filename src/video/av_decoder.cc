@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <thread>
+#include <vector>
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -22,6 +23,8 @@ namespace {
 constexpr unsigned kMaxThreads = 16;
 // converted regions start and end on whole 16-pixel columns (swscale's vector paths)
 constexpr int kColumnAlignPx = 16;
+// swscale contexts kept for regions of different sizes (the LED's, the foot's, ...)
+constexpr size_t kMostPartContexts = 8;
 
 // swscale's vector paths want 16-byte aligned output rows (OpenCV gives it 32)
 constexpr int kRowAlignBytes = 32;
@@ -101,9 +104,15 @@ struct AvDecoder::Impl {
   bool ended = false;
   StreamFacts facts;
 
-  // swscale contexts: the whole picture's, and one per region size
+  // swscale contexts: the whole picture's, and one per region size (a context made again
+  // for every region of every frame cost more than the conversions: the LED's and the
+  // foot's regions differ in size)
+  struct PartContext {
+    cv::Size size_px;
+    SwsContext* context = nullptr;
+  };
   SwsContext* whole = nullptr;
-  SwsContext* part = nullptr;
+  std::vector<PartContext> parts;
   // regions are converted alone until a comparison with a whole conversion disagrees
   bool regions_checked = false;
   bool regions_exact = true;
@@ -111,7 +120,7 @@ struct AvDecoder::Impl {
 
   ~Impl() {
     sws_freeContext(whole);
-    sws_freeContext(part);
+    for (PartContext& part : parts) sws_freeContext(part.context);
     av_frame_free(&frame);
     av_packet_free(&packet);
     avcodec_free_context(&codec);
@@ -287,9 +296,17 @@ cv::Rect AvDecoder::Impl::Widened(const cv::Rect& region) const {
 void AvDecoder::Impl::ConvertRegion(const cv::Rect& region, cv::Mat& bgr) {
   const auto pixel_format = static_cast<AVPixelFormat>(frame->format);
   const AVPixFmtDescriptor* format_info = av_pix_fmt_desc_get(pixel_format);
-  part = sws_getCachedContext(part, region.width, region.height, pixel_format, region.width,
-                              region.height, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr,
-                              nullptr);
+  auto at = std::find_if(parts.begin(), parts.end(),
+                         [&](const PartContext& part) { return part.size_px == region.size(); });
+  if (at == parts.end() && parts.size() < kMostPartContexts) {
+    at = parts.insert(parts.end(), PartContext{region.size(), nullptr});
+  }
+  if (at == parts.end()) at = parts.end() - 1;  // made again for this size
+  at->size_px = region.size();
+  at->context = sws_getCachedContext(at->context, region.width, region.height, pixel_format,
+                                     region.width, region.height, AV_PIX_FMT_BGR24, SWS_BICUBIC,
+                                     nullptr, nullptr, nullptr);
+  SwsContext* part = at->context;
   int max_step[4] = {};
   av_image_fill_max_pixsteps(max_step, nullptr, format_info);
   const uint8_t* source[4] = {};
