@@ -144,6 +144,26 @@ TEST_P(AvDecoderClips, RegionsAloneEqualAWholeConversion) {
   }
 }
 
+// More region sizes than the decoder keeps swscale contexts for (8): the ones past them
+// share a context made again for each, and still convert exactly.
+TEST_P(AvDecoderClips, ManyRegionSizesEqualAWholeConversion) {
+  auto decoder = AvDecoder::Open(Clip().string());
+  ASSERT_TRUE(decoder.ok()) << decoder.status().ToString();
+  std::vector<cv::Rect> regions;
+  for (int i = 0; i < 12; ++i) regions.emplace_back(3 + 17 * i, 2 + 9 * i, 9 + 3 * i, 5 + 2 * i);
+  cv::Mat parts, whole;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE((*decoder)->Next());
+    (*decoder)->ToBgr(regions, parts);
+    (*decoder)->ToBgr({}, whole);
+    for (const cv::Rect& region : regions) {
+      const cv::Rect inside = region & cv::Rect(0, 0, whole.cols, whole.rows);
+      EXPECT_EQ(cv::norm(parts(inside), whole(inside), cv::NORM_INF), 0.0)
+          << "frame " << k << ", region " << inside;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Codecs, AvDecoderClips,
                          ::testing::Values(Case{synth::VideoCodec::kH264, 320, 240},
                                            Case{synth::VideoCodec::kH264, 326, 198},
