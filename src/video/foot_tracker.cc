@@ -134,6 +134,10 @@ constexpr size_t kQuietFrames = 5;
 constexpr double kQuietThresholds = 0.1;
 // A curve this many thresholds below rest before its rise measures more than the foot.
 constexpr double kSunkThresholds = 2.0;
+// Patches lost during the rise widen the interval down to their crossing when that came at
+// most this long before it, s (further back they rose with something else: hard3d-07,
+// --seed 2000, had lost patches cross 1.8 s before the foot did).
+constexpr double kLostRiseReachS = 0.5;
 // The height curve's own error, px: a registration reads a sharp edge moved by a fraction
 // of a pixel with a sawtooth error (~0.1 px on the 2D renderer's row-blended sprite), and a
 // shaken camera adds to it (0.16 px rms under 1 px-a-frame shake: foot_tracker_test).
@@ -626,6 +630,9 @@ struct PatchSelection {
   std::vector<double> height_px;  // per frame, up positive, rest 0; NaN where unmeasured
   std::vector<double> shake_px;   // per frame, up positive
   std::vector<double> quality;    // per frame: fraction of the foot's patches measured
+  // per frame, the median of the patches highest halfway up the rise when most of them were
+  // lost before the end and they are not the foot's (HalfwayHighest); empty otherwise
+  std::vector<double> lost_rise_px;
 };
 
 // Patches still over frames [first, until]: measured in at least half of them, and within
@@ -677,6 +684,70 @@ std::vector<std::pair<double, size_t>> FinalRises(const std::vector<size_t>& reg
     if (!stale) kept.push_back(finals[i]);
   }
   return kept;
+}
+
+// The rising patches highest halfway up: at the first frame where the second highest of
+// them (a running median over three frames) reached half of `top`, those within
+// kFootFraction of the second highest there; returned when most of them were lost more
+// than a final window before the clip's end, else empty. Where patches end says which
+// rose; when they were highest says which rose first: a fast lift outruns the registration
+// of the foot's own patches, lost low, while a shadow or the other leg, followed to the
+// clip's end, ends higher (hard3d-06, a side view at 0.44 px a mm, took its liftoff from a
+// shadow 0.24 s late). Choosing the foot by this instead cost ci3d-02 its interval (a leg
+// swinging faster than the foot above it), so it only widens a weak foot's interval
+// (CheckLostRise).
+template <typename Value>
+std::vector<size_t> HalfwayHighest(const std::vector<std::pair<double, size_t>>& finals,
+                                   size_t first, size_t frames, size_t final_count, double top,
+                                   const Value& relative) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<size_t> rising;
+  for (const auto& [final_rise, p] : finals) {
+    if (final_rise > kGroundTolerancePx) rising.push_back(p);
+  }
+  if (rising.size() < 2) return {};
+  const auto second_highest = [&](size_t f) {
+    double highest = -kInf, second = -kInf;
+    for (size_t p : rising) {
+      const double v = relative(f, p);
+      if (!std::isfinite(v)) continue;
+      second = std::max(second, std::min(highest, v));
+      highest = std::max(highest, v);
+    }
+    return second;
+  };
+  std::vector<double> envelope(frames, -kInf);
+  for (size_t f = first; f < frames; ++f) envelope[f] = second_highest(f);
+  size_t halfway = frames;
+  for (size_t f = first + 1; f + 1 < frames && halfway == frames; ++f) {
+    const double middle =
+        std::max(std::min(envelope[f - 1], envelope[f]),
+                 std::min(std::max(envelope[f - 1], envelope[f]), envelope[f + 1]));
+    if (middle >= 0.5 * top) halfway = f;
+  }
+  if (halfway == frames) return {};
+  std::vector<std::pair<double, size_t>> levels;
+  for (size_t p : rising) {
+    std::vector<double> around;
+    for (size_t f = halfway - 1; f <= halfway + 1; ++f) {
+      if (std::isfinite(relative(f, p))) around.push_back(relative(f, p));
+    }
+    if (!around.empty()) levels.emplace_back(FiniteMedian(around), p);
+  }
+  if (levels.size() < 2) return {};
+  std::sort(levels.rbegin(), levels.rend());
+  const double reference = levels[1].first;
+  std::vector<size_t> highest;
+  size_t lost = 0;
+  for (const auto& [level, p] : levels) {
+    if (level < kFootFraction * reference) continue;
+    highest.push_back(p);
+    size_t last = frames;
+    while (last > first && !std::isfinite(relative(last - 1, p))) --last;
+    if (last + final_count < frames) ++lost;
+  }
+  if (2 * lost < highest.size()) return {};
+  return highest;
 }
 
 // Rest levels, the ground (patches that end where they began: their median is the shake),
@@ -752,6 +823,11 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   }
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
   selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
+  const std::vector<size_t> halfway =
+      HalfwayHighest(finals, first, frames, final_count, top, relative);
+  if (!halfway.empty() && halfway != selection.foot) {
+    selection.lost_rise_px = MedianCurve(frames, halfway, 1, relative);
+  }
   selection.quality.assign(frames, 0.0);
   for (size_t f = 0; f < frames; ++f) {
     size_t measured = 0;
@@ -1230,6 +1306,37 @@ std::string CheckSinking(const std::vector<HeightSample>& samples,
          " s";
 }
 
+// Patches lost during the rise (PatchSelection::lost_rise_px: highest halfway up, most of
+// them lost before the end, not the foot's) that were above the threshold for three frames
+// in a row before the crossing's interval, and at most kLostRiseReachS before it, say the
+// liftoff may be as early as the frame before those: the interval is widened down to it
+// (internal::SunkCrossing) and its instant moves to the middle. Returns why, or "".
+std::string CheckLostRise(const std::vector<HeightSample>& samples, const PatchSelection& selection,
+                          const LiftoffSearch& search, const FootTrack& track, double& crossing_s,
+                          double& uncertainty_s) {
+  const std::vector<double>& lost = selection.lost_rise_px;
+  if (lost.empty()) return "";
+  size_t above = 0, crossed = samples.size();
+  const double from_s = crossing_s - uncertainty_s - kLostRiseReachS;
+  for (size_t f = search.fit_first; f < samples.size() && crossed == samples.size(); ++f) {
+    if (Seconds(samples[f].t_ns) < from_s) continue;
+    if (Seconds(samples[f].t_ns) >= crossing_s - uncertainty_s) break;
+    above = std::isfinite(lost[f]) && lost[f] > track.threshold_px ? above + 1 : 0;
+    if (above == 3) crossed = f - 2;
+  }
+  if (crossed == samples.size() || crossed == 0) return "";
+  const double early_s = Seconds(samples[crossed - 1].t_ns);
+  const double found_s = crossing_s;
+  const internal::Instant between = internal::SunkCrossing(early_s, found_s, uncertainty_s);
+  crossing_s = between.t_s;
+  uncertainty_s = between.uncertainty_s;
+  return "patches lost during the rise (a lift faster than their registration) were above "
+         "the threshold from " +
+         FormatFixed(Seconds(samples[crossed].t_ns), 3) + " s, before the crossing at " +
+         FormatFixed(found_s, 3) + " s of the foot's " + std::to_string(selection.foot.size()) +
+         " patches: the liftoff lies between " + FormatFixed(early_s, 3) + " s and that crossing";
+}
+
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
 // the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
 // a drift that comes with the rise is a shadow or a part of the robot among the ground
@@ -1269,6 +1376,8 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =
       CheckSinking(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
+  const std::string lost =
+      CheckLostRise(samples, selection, search, track, crossing_s, uncertainty_s);
   // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
   track.above_threshold =
       MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
@@ -1278,7 +1387,7 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.fit_last_frame = samples[search.fit_last].frame_index;
   track.fit_noise_px = fit.noise;
   AddConfidenceWarnings(track, selection, fit, uncertainty_s);
-  for (const std::string& why : {disagreed, sank}) {
+  for (const std::string& why : {disagreed, sank, lost}) {
     if (why.empty()) continue;
     track.warnings.push_back("low confidence: " + why);
     track.low_confidence = true;
