@@ -129,6 +129,12 @@ std::string Join(const std::vector<std::string>& parts, std::string_view separat
   return joined;
 }
 
+std::string JoinNumbers(const std::vector<double>& values, std::string_view separator) {
+  std::vector<std::string> parts;
+  for (double value : values) parts.push_back(FormatNumber(value));
+  return Join(parts, separator);
+}
+
 std::string OneOf(const std::vector<std::string>& words) {
   std::string joined;
   for (size_t i = 0; i < words.size(); ++i) {

@@ -255,6 +255,30 @@ std::string FitMarkdown(const ReportCalibration& calibration, const ReportComman
   return text + "\n";
 }
 
+// the ratio's profile (with --fit-ratio)
+std::string RatioMarkdown(const ReportCalibration& calibration, const std::string& heading) {
+  std::string text = heading + "# Stiffness ratio\n\n";
+  if (!calibration.ratio_fit)
+    return text + "No fit: " + calibration.ratio_status.ToString() + "\n\n";
+  const fit::RatioFit& fitted = *calibration.ratio_fit;
+  text +=
+      "The Buna-N stiffness times each ratio below (silicone and spring as they are), the "
+      "tension scale fitted again at each; chi2 over the ratio is the profile. " +
+      fitted.Brief() + ". The 68 % interval holds the ratios whose chi2 lies within " +
+      FormatFixed(fitted.delta_chi_square, 2) +
+      " of the least (1, times chi2/dof when that is above 1).\n\n"
+      "| Buna-N x | sigma | chi2 |\n| ---: | ---: | ---: |\n";
+  for (const fit::RatioProfileRow& row : fitted.profile) {
+    text += "| " + FormatFixed(row.ratio, 2) + " | " +
+            (row.fitted ? Signed(row.sigma, 3) + " | " + FormatFixed(row.chi_square, 2)
+                        : std::string("no fit | no fit")) +
+            " |\n";
+  }
+  text += "\n";
+  for (const std::string& warning : fitted.warnings) text += "- warning: " + warning + "\n";
+  return text + "\n";
+}
+
 std::string MonteCarloMarkdown(const ReportCalibration& calibration, const ReportCommand& command,
                                const std::string& heading) {
   const fit::MonteCarloOptions& options = command.monte_carlo;
@@ -327,6 +351,38 @@ std::string MarkdownToHtml(const std::string& markdown) {
 // ---------------------------------------------------------------------------------------
 // the calibration
 
+namespace {
+
+// The stiffness ratio: the tension scale's grid run again at each ratio but 1 (the grid
+// itself), and the profile fitted. A ratio that cannot be fitted is a result
+// (ratio_status); a simulation that fails is an error.
+Status FitRatio(const ReportCommand& command, const Calibration& calibration,
+                const sim::ModelDescription& model, const sim::SweepOptions& sweep,
+                ReportCalibration& result) {
+  std::vector<std::vector<fit::TensionSample>> grids;
+  for (double ratio : command.ratio.ratios) {
+    if (ratio == 1.0) {
+      grids.push_back(result.grid);
+      continue;
+    }
+    const std::vector<TensionPoint> points =
+        fit::GridTensionPoints(fit::ScaledBunaN(calibration.tension_points, ratio), command.fit);
+    LIFTOFF_ASSIGN_OR_RETURN(std::vector<fit::TensionSample> grid,
+                             fit::SimulateTensions(model, sweep, points));
+    grids.push_back(std::move(grid));
+  }
+  auto fitted = fit::FitStiffnessRatio(result.targets, grids, calibration.tension_points,
+                                       command.fit, command.ratio);
+  if (fitted.ok()) {
+    result.ratio_fit = std::move(fitted).value();
+  } else {
+    result.ratio_status = fitted.status();
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
                                             const Calibration& calibration,
                                             const std::vector<stats::TrialValue>& values,
@@ -381,6 +437,9 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
                            fit::SimulateTensions(model, sweep, {result.fit->tension}));
   result.at_fit = at_fit.front();
   result.fitted = FittedCalibration(calibration, *result.fit, command.manifest_path.string());
+  if (command.fit_ratio) {
+    LIFTOFF_RETURN_IF_ERROR(FitRatio(command, calibration, model, sweep, result));
+  }
   return result;
 }
 
@@ -522,6 +581,7 @@ std::string CalibrationMarkdown(const ReportCalibration& calibration, const std:
     text += "No calibration: " + calibration.fit_status.ToString() + "\n\n";
   text += RankingMarkdown(calibration, heading);
   if (!calibration.targets.empty()) text += FitMarkdown(calibration, command, heading);
+  if (command.fit_ratio && calibration.fit) text += RatioMarkdown(calibration, heading);
   text += MonteCarloMarkdown(calibration, command, heading);
   text += heading +
           "# Files\n\n"
@@ -565,6 +625,7 @@ std::string CalibrationSummary(const ReportCalibration& calibration) {
   } else {
     text += "no fit (" + calibration.fit_status.ToString() + ")";
   }
+  if (calibration.ratio_fit) text += "; stiffness " + calibration.ratio_fit->Brief();
   return text;
 }
 

@@ -37,6 +37,9 @@ struct ReportCalibration {
   Status fit_status;
   /// The simulation at the fitted tension (one run per foot), for the interpolation check.
   std::optional<fit::TensionSample> at_fit;
+  /// With --fit-ratio: the stiffness ratio's fit (or why there is none).
+  std::optional<fit::RatioFit> ratio_fit;
+  Status ratio_status;
   /// The Monte Carlo's draws with their values, and each foot's distribution.
   std::vector<fit::TensionSample> monte_carlo;
   std::vector<fit::FootDistribution> distributions;

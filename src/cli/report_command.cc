@@ -440,6 +440,9 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
           InvalidArgumentError("--fit-min/--fit-max/--fit-step/--bootstrap: " + fit.message()),
           err);
     }
+    if (Status ratio = command.ratio.Validate(); command.fit_ratio && !ratio.ok()) {
+      return ReportError(InvalidArgumentError("--ratios: " + ratio.message()), err);
+    }
     if (Status mc = command.monte_carlo.Validate(); !mc.ok()) {
       return ReportError(InvalidArgumentError("--mc-samples/--mc-sd-scale: " + mc.message()), err);
     }
@@ -531,6 +534,13 @@ Subcommand AddReportCommand(Command& parent) {
       ->ShowDefault();
   app->AddOption("--bootstrap", command->fit.bootstrap_samples, "Bootstrap resamples of the fit")
       ->ShowDefault();
+  app->AddSwitch("--fit-ratio", command->fit_ratio,
+                 "Also fit the Buna-N / silicone stiffness ratio (a grid of runs per ratio)");
+  std::vector<double>& ratios = command->ratio.ratios;
+  app->AddOption("--ratios", ratios,
+                 "With --fit-ratio: multipliers of the calibration's ratio tried, holding 1")
+      ->CommaSeparated()
+      ->ShowDefaultFrom([&ratios] { return JoinNumbers(ratios, ","); });
   app->AddOption("--mc-samples", command->monte_carlo.samples,
                   "Monte Carlo draws of the spring constants (0: none)")
       ->ShowDefault();

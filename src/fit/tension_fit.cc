@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -171,6 +173,13 @@ void AddReachWarnings(const std::vector<FootTarget>& targets, const Curves& curv
 }
 
 // chi-square per degree of freedom, and whether it is poor at the options' p
+// The chi-square above which a fit with `degrees_of_freedom` (> 0) is poor: its
+// (1 - poor_fit_p) quantile.
+double PoorFitLimit(int degrees_of_freedom, const FitOptions& options) {
+  const boost::math::chi_squared distribution(degrees_of_freedom);
+  return boost::math::quantile(distribution, 1.0 - options.poor_fit_p);
+}
+
 void JudgeGoodness(TensionFit& fit, const FitOptions& options) {
   if (fit.degrees_of_freedom <= 0) {
     fit.chi_square_per_dof = kNaN;
@@ -179,8 +188,7 @@ void JudgeGoodness(TensionFit& fit, const FitOptions& options) {
     return;
   }
   fit.chi_square_per_dof = fit.chi_square / fit.degrees_of_freedom;
-  const boost::math::chi_squared distribution(fit.degrees_of_freedom);
-  const double limit = boost::math::quantile(distribution, 1.0 - options.poor_fit_p);
+  const double limit = PoorFitLimit(fit.degrees_of_freedom, options);
   fit.poor = fit.chi_square > limit;
   fit.sigma_stddev_scaled = fit.sigma_stddev * std::sqrt(std::max(1.0, fit.chi_square_per_dof));
   if (fit.poor) {
@@ -494,6 +502,157 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
   }
   AddReachWarnings(targets, curves, fit.warnings);
   JudgeGoodness(fit, options);
+  return fit;
+}
+
+// ---------------------------------------------------------------------------------------
+// the stiffness ratio
+
+std::vector<TensionPoint> ScaledBunaN(const std::vector<TensionPoint>& points, double ratio) {
+  std::vector<TensionPoint> scaled = points;
+  for (TensionPoint& point : scaled) point.buna_n_n_per_m *= ratio;
+  return scaled;
+}
+
+Status RatioFitOptions::Validate() const {
+  const bool positive_increasing =
+      std::all_of(ratios.begin(), ratios.end(),
+                  [](double r) { return std::isfinite(r) && r > 0.0 && r <= 100.0; }) &&
+      std::adjacent_find(ratios.begin(), ratios.end(), std::greater_equal<>()) == ratios.end();
+  const bool holds_one = std::find(ratios.begin(), ratios.end(), 1.0) != ratios.end();
+  if (ratios.size() < 3 || ratios.size() > 100 || !positive_increasing || !holds_one) {
+    return InvalidArgumentError(
+        "ratios: expected 3 .. 100 increasing multipliers in (0, 100] holding 1, got " +
+        std::to_string(ratios.size()) + " values");
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+// How far the profile's chi-square stays within `level` going from row `best` towards
+// `step` (-1: lower ratios, +1: higher): the first fitted row beyond it (`reached`), or the
+// last fitted row when it never rises through it (`reached` false). The crossing lies
+// between that row and the one before it; chi-square is far from linear or quadratic over
+// a coarse grid of ratios (a sigma pinned at the grid's end bends it), so the row itself is
+// the bound: the interval is as coarse as the ratios tried.
+double ProfileBound(const std::vector<RatioProfileRow>& rows, size_t best, int step, double level,
+                    bool& reached) {
+  size_t inside = best;
+  reached = false;
+  while (step < 0 ? inside > 0 : inside + 1 < rows.size()) {
+    const size_t next = step < 0 ? inside - 1 : inside + 1;
+    if (!rows[next].fitted) break;
+    if (rows[next].chi_square > level) {
+      reached = true;
+      return rows[next].ratio;
+    }
+    inside = next;
+  }
+  return rows[inside].ratio;
+}
+
+}  // namespace
+
+namespace {
+
+// What makes the ratio's fit less than it seems: a least chi-square at the end of the ratios
+// fitted, a flat profile, no degree of freedom, a poor chi-square.
+void AddRatioWarnings(const std::vector<FootTarget>& targets, const FitOptions& fit_options,
+                      size_t best, RatioFit& fit) {
+  const auto fitted = [&](size_t i) { return fit.profile[i].fitted; };
+  size_t first = 0, last = fit.profile.size() - 1;
+  while (!fitted(first)) ++first;
+  while (!fitted(last)) --last;
+  const bool flat = fit.ratio_low == fit.profile[first].ratio &&
+                    fit.ratio_high == fit.profile[last].ratio && !fit.determined;
+  if ((best == first || best == last) && !flat) {
+    fit.warnings.push_back("the least chi-square lies at the end of the ratios fitted (x" +
+                           FormatFixed(fit.ratio, 2) +
+                           "; the end of those tried, or of those the robot stood at): the "
+                           "best ratio may lie beyond it");
+  } else if (!fit.determined) {
+    fit.warnings.push_back(
+        "the ratio is not determined by these trials: chi-square stays within " +
+        FormatFixed(fit.delta_chi_square, 1) + " of its least from x" +
+        FormatFixed(fit.ratio_low, 2) + " to x" + FormatFixed(fit.ratio_high, 2) +
+        (flat ? ", the ratios fitted" : ", reaching an end of the ratios fitted") +
+        ": a change of the ratio moves the feet as a change of the tension "
+        "scale does");
+  }
+  if (fit.degrees_of_freedom <= 0) {
+    fit.warnings.push_back(std::to_string(targets.size()) +
+                           (targets.size() == 1 ? " foot" : " feet") +
+                           " against two parameters: no degree of freedom left to judge the "
+                           "fit");
+    return;
+  }
+  const double limit = PoorFitLimit(fit.degrees_of_freedom, fit_options);
+  fit.poor = fit.chi_square > limit;
+  if (fit.poor) {
+    fit.warnings.push_back("poor fit: chi2 " + FormatFixed(fit.chi_square, 1) + " for " +
+                           Plural(fit.degrees_of_freedom, "degree") + " of freedom (above " +
+                           FormatFixed(limit, 1) + ", p < " + FormatNumber(fit_options.poor_fit_p) +
+                           "): no tension scale and ratio of this model match every foot within "
+                           "the trials' spread");
+  }
+}
+
+}  // namespace
+
+std::string RatioFit::Brief() const {
+  std::string text = "ratio x" + FormatFixed(ratio, 2) + " (68 % [" + FormatFixed(ratio_low, 2) +
+                     ", " + FormatFixed(ratio_high, 2) + "]), sigma " + FormatFixed(sigma, 2) +
+                     ", chi2 " + FormatFixed(chi_square, 1) + ", " +
+                     std::to_string(degrees_of_freedom) + " dof";
+  if (!determined) text += "; not determined by these trials";
+  if (poor) text += " (poor)";
+  return text;
+}
+
+Result<RatioFit> FitStiffnessRatio(const std::vector<FootTarget>& targets,
+                                   const std::vector<std::vector<TensionSample>>& grids,
+                                   const std::vector<TensionPoint>& points,
+                                   const FitOptions& fit_options, const RatioFitOptions& options) {
+  LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  if (grids.size() != options.ratios.size()) {
+    return InvalidArgumentError("grids: expected one per ratio (" +
+                                std::to_string(options.ratios.size()) + "), got " +
+                                std::to_string(grids.size()));
+  }
+  // the tension scale fitted at each ratio
+  RatioFit fit;
+  std::optional<size_t> best;
+  for (size_t i = 0; i < grids.size(); ++i) {
+    RatioProfileRow& row = fit.profile.emplace_back();
+    row.ratio = options.ratios[i];
+    auto at_ratio = FitTension(targets, grids[i], ScaledBunaN(points, row.ratio), fit_options);
+    if (!at_ratio.ok()) {
+      if (at_ratio.status().code() != StatusCode::kNotFound) return at_ratio.status();
+      continue;
+    }
+    row.fitted = true;
+    row.sigma = at_ratio->sigma;
+    row.chi_square = at_ratio->chi_square;
+    if (!best || row.chi_square < fit.profile[*best].chi_square) best = i;
+  }
+  if (!best) return NotFoundError("the tension scale could be fitted at no ratio");
+  fit.ratio = fit.profile[*best].ratio;
+  fit.sigma = fit.profile[*best].sigma;
+  fit.chi_square = fit.profile[*best].chi_square;
+
+  // the profile interval, and whether it says anything
+  fit.degrees_of_freedom = static_cast<int>(targets.size()) - 2;
+  if (fit.degrees_of_freedom > 0) {
+    fit.delta_chi_square =
+        std::max(1.0, fit.chi_square / static_cast<double>(fit.degrees_of_freedom));
+  }
+  const double level = fit.chi_square + fit.delta_chi_square;
+  bool low_reached = false, high_reached = false;
+  fit.ratio_low = ProfileBound(fit.profile, *best, -1, level, low_reached);
+  fit.ratio_high = ProfileBound(fit.profile, *best, +1, level, high_reached);
+  fit.determined = low_reached && high_reached;
+  AddRatioWarnings(targets, fit_options, *best, fit);
   return fit;
 }
 

@@ -365,6 +365,31 @@ TEST(CliReport, RefusesBadCalibrationOptionsBeforeWritingAnything) {
   EXPECT_FALSE(fs::exists(scratch / "report"));
 }
 
+TEST(CliReport, FitRatioProfilesTheStiffnessRatioInCalibrationMd) {
+  ScratchDir scratch;
+  ReportCommand command = SampleReport(scratch / "report");
+  command.fit_ratio = true;
+  command.ratio.ratios = {0.5, 1.0, 2.0};
+  command.monte_carlo.samples = 0;
+  const CommandRun run = RunReportCommand(command);
+  ASSERT_EQ(run.code, kExitOk) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("; stiffness ratio x"));
+  const std::string markdown = ReadFile(scratch / "report" / "calibration.md");
+  EXPECT_THAT(markdown, HasSubstr("# Stiffness ratio"));
+  EXPECT_THAT(markdown, HasSubstr("| Buna-N x | sigma | chi2 |"));
+  for (const char* row : {"| 0.50 | ", "| 1.00 | ", "| 2.00 | "}) {
+    EXPECT_THAT(markdown, HasSubstr(row)) << row;
+  }
+
+  command = SampleReport(scratch / "refused");
+  command.fit_ratio = true;
+  command.ratio.ratios = {0.5, 2.0, 4.0};
+  const CommandRun refused = RunReportCommand(command);
+  EXPECT_EQ(refused.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(refused.err, HasSubstr("--ratios: ratios: expected 3 .. 100 increasing"));
+  EXPECT_FALSE(fs::exists(scratch / "refused"));
+}
+
 TEST(CliReport, RefusesAnOutputFolderHoldingAnInput) {
   ScratchDir scratch;
   const fs::path samples = SourceDir() / "samples" / "trials";

@@ -6,6 +6,7 @@
 #include "liftoff/fit/tension_fit.h"
 
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <numbers>
 
@@ -246,6 +247,127 @@ TEST(FitTension, NeedsTwoNeighbouringCompletePoints) {
   ASSERT_TRUE(targets.ok());
   auto fit = FitTension(*targets, grid, Laika2018().tension_points, {});
   EXPECT_EQ(fit.status().code(), StatusCode::kNotFound);
+}
+
+// A grid per ratio of analytic curves: foot f's liftoff is value(f, sigma, ratio).
+std::vector<std::vector<TensionSample>> RatioGrids(
+    const RatioFitOptions& ratios, const std::function<double(Foot, double, double)>& value) {
+  std::vector<std::vector<TensionSample>> grids;
+  for (double ratio : ratios.ratios) {
+    std::vector<TensionSample>& grid = grids.emplace_back();
+    for (int i = 0; i <= 24; ++i) {  // sigma -2 .. 4, as FitOptions' default grid
+      TensionSample& sample = grid.emplace_back();
+      sample.tension.sigma = -2.0 + 0.25 * i;
+      for (Foot foot : {Foot::kA, Foot::kB, Foot::kC}) {
+        sample.liftoff_rad[static_cast<size_t>(foot)] = value(foot, sample.tension.sigma, ratio);
+      }
+    }
+  }
+  return grids;
+}
+
+// Trials at value(f, sigma, ratio) +- 0.002 rad, two per foot A, B, C.
+Result<std::vector<FootTarget>> RatioTrials(
+    const std::function<double(Foot, double, double)>& value, double sigma, double ratio) {
+  std::vector<stats::TrialValue> trials;
+  for (Foot foot : {Foot::kA, Foot::kB, Foot::kC}) {
+    trials.push_back(Trial(foot, value(foot, sigma, ratio) - 0.002));
+    trials.push_back(Trial(foot, value(foot, sigma, ratio) + 0.002));
+  }
+  return TargetsFromTrials(trials, {});
+}
+
+TEST(FitStiffnessRatio, RecoversTheRatioWhenTheFeetRespondToItDifferently) {
+  // the front foot lifts later with more Buna-N, the back one earlier, B not at all;
+  // the tension scale moves every foot alike: the ratio is pinned
+  const auto value = [](Foot foot, double sigma, double ratio) {
+    const double per_log_ratio = foot == Foot::kA ? 0.04 : (foot == Foot::kC ? -0.04 : 0.0);
+    const double base = foot == Foot::kA ? 0.40 : (foot == Foot::kC ? 0.45 : 0.42);
+    return base + 0.03 * sigma + per_log_ratio * std::log(ratio);
+  };
+  const RatioFitOptions options;
+  auto targets = RatioTrials(value, 1.0, 1.41);
+  ASSERT_TRUE(targets.ok());
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
+                               options);
+  ASSERT_TRUE(fit.ok()) << fit.status().ToString();
+  SCOPED_TRACE(fit->Brief());
+  EXPECT_DOUBLE_EQ(fit->ratio, 1.41);
+  EXPECT_NEAR(fit->sigma, 1.0, 1e-6);
+  EXPECT_TRUE(fit->determined);
+  // the interval is narrower than the grid: bounded by the neighbouring ratios
+  EXPECT_DOUBLE_EQ(fit->ratio_low, 1.0);
+  EXPECT_DOUBLE_EQ(fit->ratio_high, 2.0);
+  EXPECT_EQ(fit->degrees_of_freedom, 1);
+  EXPECT_EQ(fit->profile.size(), options.ratios.size());
+  EXPECT_TRUE(fit->warnings.empty()) << ::testing::PrintToString(fit->warnings);
+}
+
+TEST(FitStiffnessRatio, SaysWhenTheBestRatioLiesBeyondThoseTried) {
+  const auto value = [](Foot foot, double sigma, double ratio) {
+    const double per_log_ratio = foot == Foot::kA ? 0.04 : (foot == Foot::kC ? -0.04 : 0.0);
+    return 0.42 + 0.03 * sigma + per_log_ratio * std::log(ratio);
+  };
+  const RatioFitOptions options;  // up to x2
+  auto targets = RatioTrials(value, 1.0, 3.0);
+  ASSERT_TRUE(targets.ok());
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
+                               options);
+  ASSERT_TRUE(fit.ok()) << fit.status().ToString();
+  EXPECT_DOUBLE_EQ(fit->ratio, 2.0);
+  EXPECT_FALSE(fit->determined);
+  EXPECT_TRUE(fit->poor);
+  const std::string warnings = ::testing::PrintToString(fit->warnings);
+  EXPECT_THAT(warnings,
+              HasSubstr("the least chi-square lies at the end of the ratios fitted (x2.00"));
+  EXPECT_THAT(warnings, HasSubstr("poor fit: chi2"));
+}
+
+TEST(FitStiffnessRatio, SaysWhenTheRatioMovesTheFeetAsTheTensionScaleDoes) {
+  // every foot moves with sigma + 2 log(ratio): any ratio fits as well at its own sigma
+  const auto value = [](Foot foot, double sigma, double ratio) {
+    return (foot == Foot::kA ? 0.40 : (foot == Foot::kB ? 0.42 : 0.45)) +
+           0.03 * (sigma + 2.0 * std::log(ratio));
+  };
+  const RatioFitOptions options;
+  auto targets = RatioTrials(value, 1.0, 1.0);
+  ASSERT_TRUE(targets.ok());
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
+                               options);
+  ASSERT_TRUE(fit.ok()) << fit.status().ToString();
+  EXPECT_FALSE(fit->determined) << fit->Brief();
+  EXPECT_DOUBLE_EQ(fit->ratio_low, 0.5);
+  EXPECT_DOUBLE_EQ(fit->ratio_high, 2.0);
+  EXPECT_THAT(::testing::PrintToString(fit->warnings),
+              HasSubstr("the ratio is not determined by these trials"));
+  EXPECT_THAT(fit->Brief(), HasSubstr("not determined"));
+}
+
+TEST(FitStiffnessRatio, RejectsBadRatiosAndAGridPerRatioMissing) {
+  RatioFitOptions options;
+  options.ratios = {0.5, 2.0, 4.0};  // without 1
+  EXPECT_THAT(options.Validate().message(), HasSubstr("ratios: expected"));
+  options.ratios = {0.5, 1.0, 1.0};
+  EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
+  options.ratios = {0.5, 1.0, 2.0};
+  EXPECT_TRUE(options.Validate().ok());
+  auto targets = TargetsFromTrials({Trial(Foot::kA, 0.44), Trial(Foot::kA, 0.46)}, {});
+  ASSERT_TRUE(targets.ok());
+  auto fit = FitStiffnessRatio(*targets, {}, Laika2018().tension_points, {}, options);
+  EXPECT_EQ(fit.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(fit.status().message(), HasSubstr("grids: expected one per ratio (3), got 0"));
+}
+
+TEST(ScaledBunaN, ScalesBunaNAloneAtEveryPoint) {
+  const std::vector<TensionPoint> points = Laika2018().tension_points;
+  const std::vector<TensionPoint> scaled = ScaledBunaN(points, 1.5);
+  ASSERT_EQ(scaled.size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_DOUBLE_EQ(scaled[i].buna_n_n_per_m, 1.5 * points[i].buna_n_n_per_m);
+    EXPECT_EQ(scaled[i].silicone_n_per_m, points[i].silicone_n_per_m);
+    EXPECT_EQ(scaled[i].spring_n_per_m, points[i].spring_n_per_m);
+    EXPECT_EQ(scaled[i].sigma, points[i].sigma);
+  }
 }
 
 TEST(MonteCarloDraws, AreReproducibleAndSpreadAsTableOneSays) {

@@ -114,6 +114,9 @@ class Command {
 /// `parts` with `separator` between them: Join({"A", "C"}, ",") is "A,C".
 std::string Join(const std::vector<std::string>& parts, std::string_view separator);
 
+/// `values` as FormatNumber writes them, `separator` between: "0.5,1,2".
+std::string JoinNumbers(const std::vector<double>& values, std::string_view separator);
+
 /// "a or b", "a, b or c": the words a flag takes, for messages and help.
 std::string OneOf(const std::vector<std::string>& words);
 
@@ -266,11 +269,7 @@ FieldFlag<Options> NumbersFlag(std::string flag, std::string field, size_t count
                                std::function<void(Options&, const std::vector<double>&)> set,
                                std::string expected, std::string help) {
   FieldFlag<Options> bound{flag, std::move(field), false, false, {}, {}};
-  bound.text = [get](const Options& options) {
-    std::string joined;
-    for (double value : get(options)) joined += (joined.empty() ? "" : ",") + FormatNumber(value);
-    return joined;
-  };
+  bound.text = [get](const Options& options) { return JoinNumbers(get(options), ","); };
   bound.add = [flag, count, set, expected, help, text = bound.text](Command& app,
                                                                     Options& options) {
     Flag* option = app.AddOptionFunction<std::vector<double>>(

@@ -39,6 +39,10 @@ struct ReportCommand {
   /// cached beside the sweep's, keyed by these options too).
   fit::FitOptions fit;
   fit::MonteCarloOptions monte_carlo;
+  /// Also fit the ratio of the Buna-N and silicone stiffnesses: the tension scale's grid
+  /// run again at each of ratio.ratios but 1 (those runs are not cached).
+  bool fit_ratio = false;
+  fit::RatioFitOptions ratio;
   /// The gnuplot program (found on the PATH unless a path is given).
   std::string gnuplot = "gnuplot";
   /// Trials analysed at once (0: the machine's cores); the results are the same for any.

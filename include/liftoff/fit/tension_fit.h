@@ -212,6 +212,69 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
                               const std::vector<TensionPoint>& points, const FitOptions& options);
 
 // ---------------------------------------------------------------------------------------
+// the ratio of the two lattice stiffnesses (a second parameter)
+
+/// The calibration's tension points with every Buna-N stiffness times `ratio` (> 0): the
+/// Buna-N / silicone ratio scaled by `ratio`, the silicone and the spring as they were.
+std::vector<TensionPoint> ScaledBunaN(const std::vector<TensionPoint>& points, double ratio);
+
+struct RatioFitOptions {
+  /// Multipliers of the Buna-N / silicone ratio tried (each a full tension-scale grid
+  /// of runs): increasing, > 0, at least three, holding 1 (the calibration's own ratio).
+  std::vector<double> ratios = {0.5, 0.71, 1.0, 1.41, 2.0};
+
+  /// kInvalidArgument naming the field.
+  Status Validate() const;
+};
+
+/// The tension scale fitted at one ratio.
+struct RatioProfileRow {
+  double ratio = 1.0;
+  /// Whether the tension scale could be fitted there (every foot's curve searchable).
+  bool fitted = false;
+  double sigma = 0.0;
+  double chi_square = 0.0;
+};
+
+struct RatioFit {
+  /// The grid's ratio with the least chi-square, and the tension scale fitted there.
+  double ratio = 1.0;
+  double sigma = 0.0;
+  double chi_square = 0.0;
+  /// feet - 2 (the scale and the ratio).
+  int degrees_of_freedom = 0;
+  /// Every ratio tried, in order.
+  std::vector<RatioProfileRow> profile;
+  /// The ratios whose chi-square lies within `delta_chi_square` of the least, a 68 %
+  /// profile interval (delta_chi_square = 1, times chi-square / dof when that is above 1:
+  /// the misfit's spread), bounded by the first ratios tried outside it on either side (as
+  /// coarse as the ratios tried), or by the last ratio fitted when the profile never leaves
+  /// it on that side.
+  double delta_chi_square = 1.0;
+  double ratio_low = 1.0;
+  double ratio_high = 1.0;
+  /// Whether the trials pin the ratio: the interval ends inside the grid on both sides.
+  bool determined = false;
+  /// chi-square above its (1 - FitOptions::poor_fit_p) quantile for the degrees of freedom.
+  bool poor = false;
+  /// Why the ratio is not determined, or what else makes the fit less than it seems.
+  std::vector<std::string> warnings;
+
+  /// "ratio x1.41 (68 % [1.00, 2.00]), sigma 0.85, chi2 2.3, 2 dof", with "; not
+  /// determined by these trials" and " (poor)" where they apply.
+  std::string Brief() const;
+};
+
+/// Fits the tension scale at each of options.ratios (`grids[i]`: the runs of
+/// GridTensionPoints(ScaledBunaN(points, ratios[i]), fit_options)) and profiles chi-square
+/// over the ratio. kInvalidArgument for bad options or a grid count that does not match;
+/// kNotFound when no ratio could be fitted.
+Result<RatioFit> FitStiffnessRatio(const std::vector<FootTarget>& targets,
+                                   const std::vector<std::vector<TensionSample>>& grids,
+                                   const std::vector<TensionPoint>& points,
+                                   const FitOptions& fit_options, const RatioFitOptions& options);
+
+// ---------------------------------------------------------------------------------------
 // Monte Carlo over the spring constants
 
 struct MonteCarloOptions {
