@@ -631,7 +631,8 @@ struct PatchSelection {
   std::vector<double> shake_px;   // per frame, up positive
   std::vector<double> quality;    // per frame: fraction of the foot's patches measured
   // per frame, the median of the patches highest halfway up the rise when most of them were
-  // lost before the end and they are not the foot's (HalfwayHighest); empty otherwise
+  // lost before the end, less the foot's (HalfwayHighest; NaN where fewer than two of them
+  // are measured, when there are two or more); empty when none is left
   std::vector<double> lost_rise_px;
 };
 
@@ -746,7 +747,7 @@ std::vector<size_t> HalfwayHighest(const std::vector<std::pair<double, size_t>>&
     while (last > first && !std::isfinite(relative(last - 1, p))) --last;
     if (last + final_count < frames) ++lost;
   }
-  if (2 * lost < highest.size()) return {};
+  if (2 * lost <= highest.size()) return {};
   return highest;
 }
 
@@ -823,10 +824,13 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   }
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
   selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
-  const std::vector<size_t> halfway =
-      HalfwayHighest(finals, first, frames, final_count, top, relative);
-  if (!halfway.empty() && halfway != selection.foot) {
-    selection.lost_rise_px = MedianCurve(frames, halfway, 1, relative);
+  std::vector<size_t> halfway = HalfwayHighest(finals, first, frames, final_count, top, relative);
+  std::erase_if(halfway, [&](size_t p) {
+    return std::find(selection.foot.begin(), selection.foot.end(), p) != selection.foot.end();
+  });
+  if (!halfway.empty()) {
+    selection.lost_rise_px =
+        MedianCurve(frames, halfway, std::min<size_t>(2, halfway.size()), relative);
   }
   selection.quality.assign(frames, 0.0);
   for (size_t f = 0; f < frames; ++f) {
@@ -1307,24 +1311,33 @@ std::string CheckSinking(const std::vector<HeightSample>& samples,
 }
 
 // Patches lost during the rise (PatchSelection::lost_rise_px: highest halfway up, most of
-// them lost before the end, not the foot's) that were above the threshold for three frames
-// in a row before the crossing's interval, and at most kLostRiseReachS before it, say the
-// liftoff may be as early as the frame before those: the interval is widened down to it
-// (internal::SunkCrossing) and its instant moves to the middle. Returns why, or "".
+// them lost before the end, less the foot's) whose median rose from the fit's level plus
+// the threshold or below to above it for three frames in a row, before the crossing's
+// interval and at most kLostRiseReachS before it, say the liftoff may be as early as the
+// frame before those: the interval is widened down to it (internal::SunkCrossing) and its
+// instant moves to the middle. Returns why, or "".
 std::string CheckLostRise(const std::vector<HeightSample>& samples, const PatchSelection& selection,
                           const LiftoffSearch& search, const FootTrack& track, double& crossing_s,
                           double& uncertainty_s) {
   const std::vector<double>& lost = selection.lost_rise_px;
   if (lost.empty()) return "";
-  size_t above = 0, crossed = samples.size();
+  // a run of three frames above the fit's level plus the threshold that starts, from a
+  // frame at or below it, no earlier than kLostRiseReachS before the interval
+  const double level = search.fit.level + track.threshold_px;
   const double from_s = crossing_s - uncertainty_s - kLostRiseReachS;
-  for (size_t f = search.fit_first; f < samples.size() && crossed == samples.size(); ++f) {
-    if (Seconds(samples[f].t_ns) < from_s) continue;
+  size_t above = 0, crossed = samples.size();
+  for (size_t f = std::max<size_t>(search.fit_first, 1); f < samples.size(); ++f) {
     if (Seconds(samples[f].t_ns) >= crossing_s - uncertainty_s) break;
-    above = std::isfinite(lost[f]) && lost[f] > track.threshold_px ? above + 1 : 0;
-    if (above == 3) crossed = f - 2;
+    above = std::isfinite(lost[f]) && lost[f] > level ? above + 1 : 0;
+    if (above != 3) continue;
+    const size_t start = f - 2;
+    if (start > 0 && Seconds(samples[start].t_ns) >= from_s && std::isfinite(lost[start - 1]) &&
+        lost[start - 1] <= level) {
+      crossed = start;
+      break;
+    }
   }
-  if (crossed == samples.size() || crossed == 0) return "";
+  if (crossed == samples.size()) return "";
   const double early_s = Seconds(samples[crossed - 1].t_ns);
   const double found_s = crossing_s;
   const internal::Instant between = internal::SunkCrossing(early_s, found_s, uncertainty_s);

@@ -368,6 +368,10 @@ TEST(FootTracker, AFootOutrunningItsPatchesWidensTheIntervalToTheirCrossing) {
   const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
   const double uncertainty_s = static_cast<double>(track->above_threshold.uncertainty_ns) * 1e-9;
   EXPECT_LE(std::abs(found_s - truth_s), uncertainty_s + 1e-3) << track->Brief();
+  // widened down to the foot's own crossing, no further: its lower end within two frames
+  // before the truth, and the whole interval well under the 0.5 s reach
+  EXPECT_GE(found_s - uncertainty_s, truth_s - 2.0 / 30) << track->Brief();
+  EXPECT_LT(uncertainty_s, 0.25) << track->Brief();
   EXPECT_TRUE(track->low_confidence);
   const bool said =
       std::any_of(track->warnings.begin(), track->warnings.end(), [](const std::string& w) {
