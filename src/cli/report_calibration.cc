@@ -270,7 +270,8 @@ std::string RatioMarkdown(const ReportCalibration& calibration, const std::strin
       "| Buna-N x | sigma | chi2 |\n| ---: | ---: | ---: |\n";
   for (const fit::RatioProfileRow& row : fitted.profile) {
     text += "| " + FormatFixed(row.ratio, 2) + " | " +
-            (row.fitted ? Signed(row.sigma, 3) + " | " + FormatFixed(row.chi_square, 2)
+            (row.fitted ? Signed(row.sigma, 3) + (row.at_edge ? " (edge)" : "") + " | " +
+                              FormatFixed(row.chi_square, 2)
                         : std::string("no fit | no fit")) +
             " |\n";
   }
@@ -625,7 +626,11 @@ std::string CalibrationSummary(const ReportCalibration& calibration) {
   } else {
     text += "no fit (" + calibration.fit_status.ToString() + ")";
   }
-  if (calibration.ratio_fit) text += "; stiffness " + calibration.ratio_fit->Brief();
+  if (calibration.ratio_fit) {
+    text += "; stiffness " + calibration.ratio_fit->Brief();
+  } else if (!calibration.ratio_status.ok()) {
+    text += "; stiffness ratio: no fit (" + calibration.ratio_status.ToString() + ")";
+  }
   return text;
 }
 

@@ -443,6 +443,9 @@ int RunReport(const ReportCommand& command, std::ostream& out, std::ostream& err
     if (Status ratio = command.ratio.Validate(); command.fit_ratio && !ratio.ok()) {
       return ReportError(InvalidArgumentError("--ratios: " + ratio.message()), err);
     }
+    if (!command.fit_ratio && command.ratio.ratios != fit::RatioFitOptions{}.ratios) {
+      return ReportError(InvalidArgumentError("--ratios: given without --fit-ratio"), err);
+    }
     if (Status mc = command.monte_carlo.Validate(); !mc.ok()) {
       return ReportError(InvalidArgumentError("--mc-samples/--mc-sd-scale: " + mc.message()), err);
     }

@@ -520,11 +520,16 @@ Status RatioFitOptions::Validate() const {
                   [](double r) { return std::isfinite(r) && r > 0.0 && r <= 100.0; }) &&
       std::adjacent_find(ratios.begin(), ratios.end(), std::greater_equal<>()) == ratios.end();
   const bool holds_one = std::find(ratios.begin(), ratios.end(), 1.0) != ratios.end();
-  if (ratios.size() < 3 || ratios.size() > 100 || !positive_increasing || !holds_one) {
-    return InvalidArgumentError(
-        "ratios: expected 3 .. 100 increasing multipliers in (0, 100] holding 1, got " +
-        std::to_string(ratios.size()) + " values");
+  const std::string expected =
+      "ratios: expected 3 .. 100 increasing multipliers in (0, 100] "
+      "holding 1, got ";
+  if (ratios.size() < 3 || ratios.size() > 100) {
+    return InvalidArgumentError(expected + std::to_string(ratios.size()) + " values");
   }
+  if (!positive_increasing) {
+    return InvalidArgumentError(expected + "values out of range or not increasing");
+  }
+  if (!holds_one) return InvalidArgumentError(expected + "none equal to 1");
   return Status::Ok();
 }
 
@@ -564,9 +569,26 @@ void AddRatioWarnings(const std::vector<FootTarget>& targets, const FitOptions& 
   size_t first = 0, last = fit.profile.size() - 1;
   while (!fitted(first)) ++first;
   while (!fitted(last)) --last;
+  const auto fitted_count = std::count_if(fit.profile.begin(), fit.profile.end(),
+                                          [](const RatioProfileRow& row) { return row.fitted; });
   const bool flat = fit.ratio_low == fit.profile[first].ratio &&
                     fit.ratio_high == fit.profile[last].ratio && !fit.determined;
-  if ((best == first || best == last) && !flat) {
+  std::string edges;
+  for (const RatioProfileRow& row : fit.profile) {
+    if (row.fitted && row.at_edge)
+      edges += (edges.empty() ? "x" : ", x") + FormatFixed(row.ratio, 2);
+  }
+  if (!edges.empty()) {
+    fit.warnings.push_back("at " + edges +
+                           " the tension scale sits at an end of its searched range (the grid's "
+                           "end, or beyond it the robot did not stand): there chi-square only "
+                           "bounds the profile, which may lie lower");
+  }
+  if (fitted_count < 2) {
+    fit.warnings.push_back("the tension scale could be fitted at one ratio only (x" +
+                           FormatFixed(fit.ratio, 2) +
+                           "): at the others some foot did not stand or lift; nothing to profile");
+  } else if ((best == first || best == last) && !flat) {
     fit.warnings.push_back("the least chi-square lies at the end of the ratios fitted (x" +
                            FormatFixed(fit.ratio, 2) +
                            "; the end of those tried, or of those the robot stood at): the "
@@ -634,6 +656,8 @@ Result<RatioFit> FitStiffnessRatio(const std::vector<FootTarget>& targets,
     row.fitted = true;
     row.sigma = at_ratio->sigma;
     row.chi_square = at_ratio->chi_square;
+    row.at_edge =
+        row.sigma <= at_ratio->searched_sigma_min || row.sigma >= at_ratio->searched_sigma_max;
     if (!best || row.chi_square < fit.profile[*best].chi_square) best = i;
   }
   if (!best) return NotFoundError("the tension scale could be fitted at no ratio");

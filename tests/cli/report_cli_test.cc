@@ -388,6 +388,12 @@ TEST(CliReport, FitRatioProfilesTheStiffnessRatioInCalibrationMd) {
   EXPECT_EQ(refused.code, ExitCodeFor(StatusCode::kInvalidArgument));
   EXPECT_THAT(refused.err, HasSubstr("--ratios: ratios: expected 3 .. 100 increasing"));
   EXPECT_FALSE(fs::exists(scratch / "refused"));
+  command.fit_ratio = false;
+  command.ratio.ratios = {0.5, 1.0, 3.0};
+  const CommandRun alone = RunReportCommand(command);
+  EXPECT_EQ(alone.code, ExitCodeFor(StatusCode::kInvalidArgument));
+  EXPECT_THAT(alone.err, HasSubstr("--ratios: given without --fit-ratio"));
+  EXPECT_FALSE(fs::exists(scratch / "refused"));
 }
 
 TEST(CliReport, RefusesAnOutputFolderHoldingAnInput) {

@@ -323,6 +323,45 @@ TEST(FitStiffnessRatio, SaysWhenTheBestRatioLiesBeyondThoseTried) {
   EXPECT_THAT(warnings, HasSubstr("poor fit: chi2"));
 }
 
+TEST(FitStiffnessRatio, MarksRatiosWhoseTensionScaleSitsAtTheGridsEnd) {
+  const auto value = [](Foot foot, double sigma, double ratio) {
+    const double per_log_ratio = foot == Foot::kA ? 0.04 : (foot == Foot::kC ? -0.04 : 0.0);
+    return 0.42 + 0.03 * sigma + per_log_ratio * std::log(ratio);
+  };
+  const RatioFitOptions options;
+  // the trials were made at sigma 3.9, ratio 1; at x0.5 the runs stop at sigma 3 (beyond,
+  // the robot "did not stand"), so the scale sits at the end of what was searched there
+  auto targets = RatioTrials(value, 3.9, 1.0);
+  ASSERT_TRUE(targets.ok());
+  std::vector<std::vector<TensionSample>> grids = RatioGrids(options, value);
+  for (TensionSample& sample : grids[0]) {
+    if (sample.tension.sigma > 3.0) sample.liftoff_rad = {};
+  }
+  auto fit = FitStiffnessRatio(*targets, grids, Laika2018().tension_points, {}, options);
+  ASSERT_TRUE(fit.ok()) << fit.status().ToString();
+  EXPECT_TRUE(fit->profile[0].at_edge);
+  EXPECT_FALSE(fit->profile[2].at_edge);
+  EXPECT_THAT(::testing::PrintToString(fit->warnings),
+              HasSubstr("at x0.50 the tension scale sits at an end of its searched range"));
+}
+
+TEST(FitStiffnessRatio, SaysWhenOneRatioAloneCouldBeFitted) {
+  const auto value = [](Foot, double sigma, double) { return 0.42 + 0.03 * sigma; };
+  const RatioFitOptions options;
+  auto targets = RatioTrials(value, 1.0, 1.0);
+  ASSERT_TRUE(targets.ok());
+  std::vector<std::vector<TensionSample>> grids = RatioGrids(options, value);
+  for (size_t i : {0u, 1u, 3u, 4u}) {
+    for (TensionSample& sample : grids[i]) sample.liftoff_rad = {};
+  }
+  auto fit = FitStiffnessRatio(*targets, grids, Laika2018().tension_points, {}, options);
+  ASSERT_TRUE(fit.ok()) << fit.status().ToString();
+  EXPECT_DOUBLE_EQ(fit->ratio, 1.0);
+  EXPECT_FALSE(fit->determined);
+  EXPECT_THAT(::testing::PrintToString(fit->warnings),
+              HasSubstr("the tension scale could be fitted at one ratio only (x1.00)"));
+}
+
 TEST(FitStiffnessRatio, SaysWhenTheRatioMovesTheFeetAsTheTensionScaleDoes) {
   // every foot moves with sigma + 2 log(ratio): any ratio fits as well at its own sigma
   const auto value = [](Foot foot, double sigma, double ratio) {
@@ -347,8 +386,11 @@ TEST(FitStiffnessRatio, RejectsBadRatiosAndAGridPerRatioMissing) {
   RatioFitOptions options;
   options.ratios = {0.5, 2.0, 4.0};  // without 1
   EXPECT_THAT(options.Validate().message(), HasSubstr("ratios: expected"));
+  EXPECT_THAT(options.Validate().message(), HasSubstr("got none equal to 1"));
   options.ratios = {0.5, 1.0, 1.0};
-  EXPECT_EQ(options.Validate().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(options.Validate().message(), HasSubstr("got values out of range or not increasing"));
+  options.ratios = {1.0, 2.0};
+  EXPECT_THAT(options.Validate().message(), HasSubstr("got 2 values"));
   options.ratios = {0.5, 1.0, 2.0};
   EXPECT_TRUE(options.Validate().ok());
   auto targets = TargetsFromTrials({Trial(Foot::kA, 0.44), Trial(Foot::kA, 0.46)}, {});

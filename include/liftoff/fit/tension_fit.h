@@ -234,6 +234,9 @@ struct RatioProfileRow {
   bool fitted = false;
   double sigma = 0.0;
   double chi_square = 0.0;
+  /// The fitted sigma at an end of the range searched at this ratio (its chi-square then
+  /// only bounds the ratio's: the best tension may lie beyond).
+  bool at_edge = false;
 };
 
 struct RatioFit {
@@ -248,8 +251,8 @@ struct RatioFit {
   /// The ratios whose chi-square lies within `delta_chi_square` of the least, a 68 %
   /// profile interval (delta_chi_square = 1, times chi-square / dof when that is above 1:
   /// the misfit's spread), bounded by the first ratios tried outside it on either side (as
-  /// coarse as the ratios tried), or by the last ratio fitted when the profile never leaves
-  /// it on that side.
+  /// coarse as the ratios tried), or, where the profile does not leave it on that side, by
+  /// the last ratio fitted before the end of the ratios or one that could not be fitted.
   double delta_chi_square = 1.0;
   double ratio_low = 1.0;
   double ratio_high = 1.0;
