@@ -121,6 +121,11 @@ constexpr double kUnclippedShare = 0.25;
 // The pixels of a light hold their levels much better than a whole region: the frames
 // before and after a step must stay within this fraction of it.
 constexpr double kFlatFracPixels = 0.2;
+// The LED's pixels: the frame just before a step may be lit up to this fraction and be left
+// out of the frames before (a codec building a small spot up over frames made re-drawn
+// hard3d-06's half-lit frame, --seed 6000, 57 % of the step in its pixels, and the frame
+// before it was not yet a step).
+constexpr double kPartlyLitBeforeFrac = 0.75;
 // The frames after a step may go on in its direction by at most this fraction of it (a
 // codec refines a small bright spot over a few frames), during its confirmation too.
 constexpr double kCreepFrac = 0.5;
@@ -839,8 +844,9 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
   event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
   // the levels: the medians of the frames before and after (the pixels of a small light
   // may still be catching up after it: the creep widens the partly lit frame's band)
-  const WindowShape shape = ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
-                                    options.threshold_frac, window_copy);
+  const WindowShape shape =
+      ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
+              std::max(options.threshold_frac, kPartlyLitBeforeFrac), window_copy);
   if (!(shape.step > 0)) return false;
   const double widest = std::max(shape.before_spread, shape.after_against);
   if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {

@@ -530,4 +530,22 @@ TEST(CliSync, VideoModeAndHandInstantsExcludeEachOtherAndOneIsNeeded) {
 }
 
 }  // namespace
+// A 0.6 px LED on its real pixels (tests/video/data/README.md: a lossless crop of an H.264
+// clip liftoff rendered): H.264 builds the spot up over four frames and shows the half-lit
+// frame above half of the step, and the frame before the step's is still dark. Found, within
+// half a frame, the truth inside its interval (before kPartlyLitBeforeFrac: not found).
+TEST(ClipAnalysis, ATinyLedACodecBuildsUpIsFoundOnItsRealPixels) {
+  ClipAnalysisOptions options;
+  options.led.roi_px = cv::Rect(98, 12, 24, 24);
+  const auto analysis =
+      AnalyzeClip(SourceDir() / "tests" / "video" / "data" / "hard3d-06-seed6000-led.mkv", options);
+  ASSERT_TRUE(analysis.ok()) << analysis.status().ToString();
+  ASSERT_EQ(analysis->led.pulses.size(), 1u) << analysis->led.Brief();
+  const LedPulse& pulse = analysis->led.pulses.front();
+  const double error_ns = static_cast<double>(pulse.on_ns) - 0.8e9;
+  EXPECT_LE(std::abs(error_ns), 0.5e9 / 30.0) << analysis->led.Brief();
+  EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns))
+      << analysis->led.Brief();
+}
+
 }  // namespace liftoff::video
