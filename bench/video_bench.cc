@@ -118,6 +118,7 @@ Result<double> FullAnalysisMs(const BenchClip& clip, int queue_frames) {
   const int64_t started_ns = MonotonicNowNs();
   auto analysis = video::AnalyzeClip(clip.trial.video_path, OptionsFor(clip, queue_frames));
   if (!analysis.ok()) return analysis.status();
+  if (analysis->timing.frames <= 0) return NotFoundError("the analysis read no frame");
   return 1e-6 * static_cast<double>(MonotonicNowNs() - started_ns) /
          static_cast<double>(analysis->timing.frames);
 }

@@ -738,6 +738,7 @@ std::vector<size_t> HalfwayHighest(const std::vector<std::pair<double, size_t>>&
   if (levels.size() < 2) return {};
   std::sort(levels.rbegin(), levels.rend());
   const double reference = levels[1].first;
+  if (!(reference > 0)) return {};  // the rising patches had not risen there
   std::vector<size_t> highest;
   size_t lost = 0;
   for (const auto& [level, p] : levels) {
@@ -1320,7 +1321,7 @@ std::string CheckLostRise(const std::vector<HeightSample>& samples, const PatchS
                           const LiftoffSearch& search, const FootTrack& track, double& crossing_s,
                           double& uncertainty_s) {
   const std::vector<double>& lost = selection.lost_rise_px;
-  if (lost.empty()) return "";
+  if (lost.empty() || !std::isfinite(crossing_s) || !std::isfinite(uncertainty_s)) return "";
   // a run of three frames above the fit's level plus the threshold that starts, from a
   // frame at or below it, no earlier than kLostRiseReachS before the interval
   const double level = search.fit.level + track.threshold_px;
