@@ -372,8 +372,7 @@ Status FitRatio(const ReportCommand& command, const Calibration& calibration,
                              fit::SimulateTensions(model, sweep, points));
     grids.push_back(std::move(grid));
   }
-  auto fitted = fit::FitStiffnessRatio(result.targets, grids, calibration.tension_points,
-                                       command.fit, command.ratio);
+  auto fitted = fit::FitStiffnessRatio(result.targets, grids, command.fit, command.ratio);
   if (fitted.ok()) {
     result.ratio_fit = std::move(fitted).value();
   } else {

@@ -72,6 +72,15 @@ double ChiSquareAt(const Curves& curves, const std::vector<double>& means,
   return chi_square;
 }
 
+// each target foot's hardware mean and the standard error that weighs it
+void MeansAndErrors(const std::vector<FootTarget>& targets, std::vector<double>& means,
+                    std::vector<double>& errors) {
+  for (const FootTarget& target : targets) {
+    means.push_back(target.summary.mean);
+    errors.push_back(target.standard_error_rad);
+  }
+}
+
 // chi-square is quadratic in t on each segment of the piecewise-linear curves: its
 // minimum there is closed-form, clamped to the segment
 CurveFit FitCurves(const Curves& curves, const std::vector<double>& means,
@@ -172,7 +181,6 @@ void AddReachWarnings(const std::vector<FootTarget>& targets, const Curves& curv
   }
 }
 
-// chi-square per degree of freedom, and whether it is poor at the options' p
 // The chi-square above which a fit with `degrees_of_freedom` (> 0) is poor: its
 // (1 - poor_fit_p) quantile.
 double PoorFitLimit(int degrees_of_freedom, const FitOptions& options) {
@@ -180,6 +188,7 @@ double PoorFitLimit(int degrees_of_freedom, const FitOptions& options) {
   return boost::math::quantile(distribution, 1.0 - options.poor_fit_p);
 }
 
+// chi-square per degree of freedom, and whether it is poor at the options' p
 void JudgeGoodness(TensionFit& fit, const FitOptions& options) {
   if (fit.degrees_of_freedom <= 0) {
     fit.chi_square_per_dof = kNaN;
@@ -466,10 +475,7 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
   if (targets.empty()) return InvalidArgumentError("no hardware targets to fit");
   LIFTOFF_ASSIGN_OR_RETURN(const Curves curves, SearchableCurves(targets, grid));
   std::vector<double> means, errors;
-  for (const FootTarget& target : targets) {
-    means.push_back(target.summary.mean);
-    errors.push_back(target.standard_error_rad);
-  }
+  MeansAndErrors(targets, means, errors);
 
   // the fit, and its spread over resampled trials
   TensionFit fit;
@@ -557,10 +563,6 @@ double ProfileBound(const std::vector<RatioProfileRow>& rows, size_t best, int s
   return rows[inside].ratio;
 }
 
-}  // namespace
-
-namespace {
-
 // What makes the ratio's fit less than it seems: a least chi-square at the end of the ratios
 // fitted, a flat profile, no degree of freedom, a poor chi-square.
 void AddRatioWarnings(const std::vector<FootTarget>& targets, const FitOptions& fit_options,
@@ -598,7 +600,7 @@ void AddRatioWarnings(const std::vector<FootTarget>& targets, const FitOptions& 
         "the ratio is not determined by these trials: chi-square stays within " +
         FormatFixed(fit.delta_chi_square, 1) + " of its least from x" +
         FormatFixed(fit.ratio_low, 2) + " to x" + FormatFixed(fit.ratio_high, 2) +
-        (flat ? ", the ratios fitted" : ", reaching an end of the ratios fitted") +
+        (flat ? ", the ratios fitted" : ", reaching the last ratio fitted on that side") +
         ": a change of the ratio moves the feet as a change of the tension "
         "scale does");
   }
@@ -634,30 +636,31 @@ std::string RatioFit::Brief() const {
 
 Result<RatioFit> FitStiffnessRatio(const std::vector<FootTarget>& targets,
                                    const std::vector<std::vector<TensionSample>>& grids,
-                                   const std::vector<TensionPoint>& points,
                                    const FitOptions& fit_options, const RatioFitOptions& options) {
   LIFTOFF_RETURN_IF_ERROR(options.Validate());
+  LIFTOFF_RETURN_IF_ERROR(fit_options.Validate());
+  if (targets.empty()) return InvalidArgumentError("no hardware targets to fit");
   if (grids.size() != options.ratios.size()) {
     return InvalidArgumentError("grids: expected one per ratio (" +
                                 std::to_string(options.ratios.size()) + "), got " +
                                 std::to_string(grids.size()));
   }
-  // the tension scale fitted at each ratio
+  // the tension scale fitted at each ratio (as FitTension fits it; its bootstrap is not
+  // needed for the profile)
+  std::vector<double> means, errors;
+  MeansAndErrors(targets, means, errors);
   RatioFit fit;
   std::optional<size_t> best;
   for (size_t i = 0; i < grids.size(); ++i) {
     RatioProfileRow& row = fit.profile.emplace_back();
     row.ratio = options.ratios[i];
-    auto at_ratio = FitTension(targets, grids[i], ScaledBunaN(points, row.ratio), fit_options);
-    if (!at_ratio.ok()) {
-      if (at_ratio.status().code() != StatusCode::kNotFound) return at_ratio.status();
-      continue;
-    }
+    const Result<Curves> curves = SearchableCurves(targets, grids[i]);
+    if (!curves.ok()) continue;  // no two neighbouring complete points at this ratio
+    const CurveFit at_ratio = FitCurves(*curves, means, errors);
     row.fitted = true;
-    row.sigma = at_ratio->sigma;
-    row.chi_square = at_ratio->chi_square;
-    row.at_edge =
-        row.sigma <= at_ratio->searched_sigma_min || row.sigma >= at_ratio->searched_sigma_max;
+    row.sigma = at_ratio.sigma;
+    row.chi_square = at_ratio.chi_square;
+    row.at_edge = row.sigma <= curves->sigma.front() || row.sigma >= curves->sigma.back();
     if (!best || row.chi_square < fit.profile[*best].chi_square) best = i;
   }
   if (!best) return NotFoundError("the tension scale could be fitted at no ratio");

@@ -288,8 +288,7 @@ TEST(FitStiffnessRatio, RecoversTheRatioWhenTheFeetRespondToItDifferently) {
   const RatioFitOptions options;
   auto targets = RatioTrials(value, 1.0, 1.41);
   ASSERT_TRUE(targets.ok());
-  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
-                               options);
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), {}, options);
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
   SCOPED_TRACE(fit->Brief());
   EXPECT_DOUBLE_EQ(fit->ratio, 1.41);
@@ -311,8 +310,7 @@ TEST(FitStiffnessRatio, SaysWhenTheBestRatioLiesBeyondThoseTried) {
   const RatioFitOptions options;  // up to x2
   auto targets = RatioTrials(value, 1.0, 3.0);
   ASSERT_TRUE(targets.ok());
-  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
-                               options);
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), {}, options);
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
   EXPECT_DOUBLE_EQ(fit->ratio, 2.0);
   EXPECT_FALSE(fit->determined);
@@ -337,7 +335,7 @@ TEST(FitStiffnessRatio, MarksRatiosWhoseTensionScaleSitsAtTheGridsEnd) {
   for (TensionSample& sample : grids[0]) {
     if (sample.tension.sigma > 3.0) sample.liftoff_rad = {};
   }
-  auto fit = FitStiffnessRatio(*targets, grids, Laika2018().tension_points, {}, options);
+  auto fit = FitStiffnessRatio(*targets, grids, {}, options);
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
   EXPECT_TRUE(fit->profile[0].at_edge);
   EXPECT_FALSE(fit->profile[2].at_edge);
@@ -354,7 +352,7 @@ TEST(FitStiffnessRatio, SaysWhenOneRatioAloneCouldBeFitted) {
   for (size_t i : {0u, 1u, 3u, 4u}) {
     for (TensionSample& sample : grids[i]) sample.liftoff_rad = {};
   }
-  auto fit = FitStiffnessRatio(*targets, grids, Laika2018().tension_points, {}, options);
+  auto fit = FitStiffnessRatio(*targets, grids, {}, options);
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
   EXPECT_DOUBLE_EQ(fit->ratio, 1.0);
   EXPECT_FALSE(fit->determined);
@@ -371,8 +369,7 @@ TEST(FitStiffnessRatio, SaysWhenTheRatioMovesTheFeetAsTheTensionScaleDoes) {
   const RatioFitOptions options;
   auto targets = RatioTrials(value, 1.0, 1.0);
   ASSERT_TRUE(targets.ok());
-  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), Laika2018().tension_points, {},
-                               options);
+  auto fit = FitStiffnessRatio(*targets, RatioGrids(options, value), {}, options);
   ASSERT_TRUE(fit.ok()) << fit.status().ToString();
   EXPECT_FALSE(fit->determined) << fit->Brief();
   EXPECT_DOUBLE_EQ(fit->ratio_low, 0.5);
@@ -395,7 +392,7 @@ TEST(FitStiffnessRatio, RejectsBadRatiosAndAGridPerRatioMissing) {
   EXPECT_TRUE(options.Validate().ok());
   auto targets = TargetsFromTrials({Trial(Foot::kA, 0.44), Trial(Foot::kA, 0.46)}, {});
   ASSERT_TRUE(targets.ok());
-  auto fit = FitStiffnessRatio(*targets, {}, Laika2018().tension_points, {}, options);
+  auto fit = FitStiffnessRatio(*targets, {}, {}, options);
   EXPECT_EQ(fit.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(fit.status().message(), HasSubstr("grids: expected one per ratio (3), got 0"));
 }

@@ -268,13 +268,12 @@ struct RatioFit {
   std::string Brief() const;
 };
 
-/// Fits the tension scale at each of options.ratios (`grids[i]`: the runs of
-/// GridTensionPoints(ScaledBunaN(points, ratios[i]), fit_options)) and profiles chi-square
-/// over the ratio. kInvalidArgument for bad options or a grid count that does not match;
-/// kNotFound when no ratio could be fitted.
+/// Fits the tension scale at each of options.ratios as FitTension does (`grids[i]`: the
+/// runs of GridTensionPoints(ScaledBunaN(points, ratios[i]), fit_options)) and profiles
+/// chi-square over the ratio. kInvalidArgument for bad options, no targets or a grid count
+/// that does not match; kNotFound when no ratio could be fitted.
 Result<RatioFit> FitStiffnessRatio(const std::vector<FootTarget>& targets,
                                    const std::vector<std::vector<TensionSample>>& grids,
-                                   const std::vector<TensionPoint>& points,
                                    const FitOptions& fit_options, const RatioFitOptions& options);
 
 // ---------------------------------------------------------------------------------------
