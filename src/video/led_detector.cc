@@ -93,11 +93,14 @@ constexpr size_t kTopPixelsShare = 256;
 constexpr double kPixelNoiseSigmas = 5.0;
 constexpr double kPixelStepFrac = 0.1;
 constexpr double kRoiOppositeFrac = 0.5;
-// But a small light (its strong steps, kRoiStrongFrac of the largest or more, within a
-// kSmallLightPx square) is one when the strong steps the other way stay under that share:
-// a codec renewing a tiny LED's block moves many pixels a little either way.
+// But a small light (its strong steps, kRoiStrongFrac of the largest or more, at least
+// kSmallLightShare of them within kSmallLightRadiusPx of the largest) is one when the strong
+// steps the other way stay under that share: a codec renewing a tiny LED's block moves many
+// pixels a little either way, and a few of them strongly (H.264 stepped a pixel 4 px beside
+// hard3d-06's 0.6 px LED, --seed 5000, by a third of the LED's own step).
 constexpr double kRoiStrongFrac = 0.3;
-constexpr size_t kSmallLightPx = 6;
+constexpr int64_t kSmallLightRadiusPx = 3;
+constexpr double kSmallLightShare = 0.8;
 // With an ROI, its outer kBorderPx px are left out of the detection (camera shake carries
 // an edge or a highlight from just outside the ROI into it, where it looks like a light
 // that switched on), narrower in an ROI under 2 * kBorderPx + kMinInnerPx px.
@@ -413,7 +416,7 @@ struct LedDetector::Impl {
   double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain);
 
   // Whether the pixels that stepped strongly (kRoiStrongFrac of the largest step or more)
-  // are a small light, within a kSmallLightPx square, that the strong steps the other way
+  // are a small light, most of them near the largest, that the strong steps the other way
   // do not match: a codec that renews a tiny LED's block moves many pixels a little either
   // way (too many for the sum of every clear step), where an edge that moved steps its two
   // sides strongly along its length. Reads pixel_steps.
@@ -755,21 +758,24 @@ double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gai
 
 bool LedDetector::Impl::SmallLightInRenewedBlock(double largest, size_t width) const {
   const double strong = kRoiStrongFrac * largest;
-  double stepped_strong = 0.0, opposite_strong = 0.0;
-  size_t x0 = width, x1 = 0, y0 = pixel_steps.size(), y1 = 0;
+  const auto peak = static_cast<size_t>(std::max_element(pixel_steps.begin(), pixel_steps.end()) -
+                                        pixel_steps.begin());
+  const auto near_peak = [&](size_t i) {
+    const auto dx = static_cast<int64_t>(i % width) - static_cast<int64_t>(peak % width);
+    const auto dy = static_cast<int64_t>(i / width) - static_cast<int64_t>(peak / width);
+    return std::max(std::abs(dx), std::abs(dy)) <= kSmallLightRadiusPx;
+  };
+  double stepped_strong = 0.0, stepped_near = 0.0, opposite_strong = 0.0;
   for (size_t i = 0; i < pixel_steps.size(); ++i) {
     if (pixel_steps[i] > strong) {
       stepped_strong += pixel_steps[i];
-      x0 = std::min(x0, i % width);
-      x1 = std::max(x1, i % width);
-      y0 = std::min(y0, i / width);
-      y1 = std::max(y1, i / width);
+      if (near_peak(i)) stepped_near += pixel_steps[i];
     } else if (pixel_steps[i] < -strong) {
       opposite_strong -= pixel_steps[i];
     }
   }
-  const bool small = x1 >= x0 && x1 - x0 < kSmallLightPx && y1 - y0 < kSmallLightPx;
-  return small && opposite_strong <= kRoiOppositeFrac * stepped_strong;
+  return stepped_near >= kSmallLightShare * stepped_strong &&
+         opposite_strong <= kRoiOppositeFrac * stepped_strong;
 }
 
 void LedDetector::Impl::MeasurePixelSteps(int64_t k, bool rise, double& off_sum, double& on_sum) {
