@@ -12,12 +12,13 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "area_resize.h"
+#include "height_curve.h"
 #include "liftoff/core/field_checker.h"
 #include "liftoff/core/text.h"
 #include "liftoff/core/time.h"
-#include "area_resize.h"
-#include "height_curve.h"
 #include "patch_registration.h"
+#include "patch_selection.h"
 #include "rise_fit.h"
 #include "video_util.h"
 
@@ -25,6 +26,10 @@ namespace liftoff::video {
 namespace {
 
 using internal::FiniteMedian;
+using internal::FiniteQuantile;
+using internal::kGroundTolerancePx;
+using internal::MedianCurve;
+using internal::MovingWithTheOthers;
 
 using internal::MedianOf;
 using internal::PatchMatch;
@@ -93,12 +98,6 @@ constexpr double kLagBoundFactor = 1.5;
 constexpr double kFitRestS = 3.0;
 // The curve's running median for the search, s either side.
 constexpr double kSmoothHalfS = 0.15;
-// Patches that end within this of their rest are ground, px.
-constexpr double kGroundTolerancePx = 0.5;
-// The foot's patches move all the way with it: a candidate's gain against the candidates'
-// median curve must reach this fraction of the upper quartile of their gains.
-constexpr double kFullGainQuantile = 0.75;
-constexpr double kFullGainFraction = 0.5;
 // A lift is sustained for this long (and this many frames at least), s; the rest before
 // it counts as reached after kRestingS flat.
 constexpr double kSustainS = 0.5;
@@ -550,35 +549,6 @@ class RiseTable {
   size_t patches_, measured_from_;
 };
 
-// Quantile q (0..1, linear between order statistics) of the finite values; NaN for none.
-double FiniteQuantile(std::vector<double>& values, double q) {
-  values.erase(
-      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-      values.end());
-  if (values.empty()) return kNaNd;
-  std::sort(values.begin(), values.end());
-  const double at = q * static_cast<double>(values.size() - 1);
-  const size_t below = static_cast<size_t>(std::floor(at));
-  const size_t above = std::min(values.size() - 1, below + 1);
-  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
-}
-
-// Per frame, the median over `members` of value(frame, patch); NaN where fewer than
-// `min_count` are finite.
-template <typename Value>
-std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& members,
-                                size_t min_count, const Value& value) {
-  std::vector<double> curve(frames, kNaNd);
-  std::vector<double> values;
-  for (size_t f = 0; f < frames; ++f) {
-    values.clear();
-    for (size_t p : members) values.push_back(value(f, p));
-    const double median = FiniteMedian(values);
-    if (values.size() >= std::max<size_t>(1, min_count)) curve[f] = median;
-  }
-  return curve;
-}
-
 // Median of the last `count` finite values of value(f) over frames [first, frames).
 template <typename Value>
 double FinalLevel(size_t first, size_t frames, size_t count, const Value& value) {
@@ -803,26 +773,8 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
     if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx)
       candidates.push_back(p);
   }
-  // ... and move with the others, all the way: each candidate's gain against their median
-  // curve (least squares over the frames after the rest); a patch that holds some ground or
-  // shadow moves by a fraction of the foot's motion, one on something else by none of it
-  const std::vector<double> common = MedianCurve(frames, candidates, 1, relative);
-  std::vector<double> gains(candidates.size(), 0.0);
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    double product = 0, norm = 0;
-    for (size_t f = first; f < frames; ++f) {
-      const double r = relative(f, candidates[i]);
-      if (!std::isfinite(r) || !std::isfinite(common[f])) continue;
-      product += r * common[f];
-      norm += common[f] * common[f];
-    }
-    gains[i] = norm > 0 ? product / norm : 0.0;
-  }
-  std::vector<double> sorted = gains;
-  const double full = FiniteQuantile(sorted, kFullGainQuantile);
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    if (gains[i] >= kFullGainFraction * full) selection.foot.push_back(candidates[i]);
-  }
+  // ... and move with the others, all the way
+  selection.foot = MovingWithTheOthers(candidates, first, frames, relative);
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
   selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
   std::vector<size_t> halfway = HalfwayHighest(finals, first, frames, final_count, top, relative);

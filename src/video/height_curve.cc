@@ -21,6 +21,18 @@ double FiniteMedian(std::vector<double>& values) {
   return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
 }
 
+double FiniteQuantile(std::vector<double>& values, double q) {
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+      values.end());
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const double at = q * static_cast<double>(values.size() - 1);
+  const auto below = static_cast<size_t>(std::floor(at));
+  const size_t above = std::min(values.size() - 1, below + 1);
+  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
 double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
   std::vector<double> after, before;
   for (size_t g = key; g < std::min(curve.size(), key + count); ++g) after.push_back(curve[g]);

@@ -14,6 +14,10 @@ namespace liftoff::video::internal {
 /// Median of the finite values (reorders and shortens `values`); NaN for none.
 double FiniteMedian(std::vector<double>& values);
 
+/// Quantile q (0..1, linear between order statistics) of the finite values (sorts and
+/// shortens `values`); NaN for none.
+double FiniteQuantile(std::vector<double>& values, double q);
+
 /// The curve's step at frame `key`: the median of the `count` frames from it less that of
 /// the `count` before it (0 where either has no finite value).
 double LevelStep(const std::vector<double>& curve, size_t key, size_t count);
