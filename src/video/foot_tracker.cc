@@ -604,6 +604,8 @@ struct PatchSelection {
   // lost before the end, less the foot's (HalfwayHighest; NaN where fewer than two of them
   // are measured, when there are two or more); empty when none is left
   std::vector<double> lost_rise_px;
+  // per foot patch, its curve less the shake (foot order), px
+  std::vector<std::vector<double>> foot_curves_px;
 };
 
 // Patches still over frames [first, until]: measured in at least half of them, and within
@@ -777,6 +779,10 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   selection.foot = MovingWithTheOthers(candidates, first, frames, relative);
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
   selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
+  for (size_t p : selection.foot) {
+    std::vector<double>& curve = selection.foot_curves_px.emplace_back(frames);
+    for (size_t f = 0; f < frames; ++f) curve[f] = relative(f, p);
+  }
   std::vector<size_t> halfway = HalfwayHighest(finals, first, frames, final_count, top, relative);
   std::erase_if(halfway, [&](size_t p) {
     return std::find(selection.foot.begin(), selection.foot.end(), p) != selection.foot.end();
@@ -1338,6 +1344,14 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.still_noise_px = search.still_noise_px;
   double uncertainty_s =
       LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
+  // the foot's own patches disagreeing on the crossing (a tiny foot's patches that hold
+  // some ground lag it: re-drawn hard3d-04, --seed 5000, at 0.25 px a mm)
+  std::vector<double> t_s(samples.size());
+  for (size_t f = 0; f < samples.size(); ++f) t_s[f] = Seconds(samples[f].t_ns);
+  uncertainty_s = std::hypot(
+      uncertainty_s,
+      internal::PatchCrossingSpreadS(t_s, selection.foot_curves_px, search.fit_first,
+                                     fit.level + track.threshold_px, crossing_s, kSustainFrames));
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =
