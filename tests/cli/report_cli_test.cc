@@ -331,18 +331,25 @@ TEST(CliReport, Hardware2018RanksTheHighestTensionFirstAndSaysTheFitIsPoor) {
   command.lookup.rule = "hold";
   command.sweep.experiment.progress = "off";
   command.monte_carlo.samples = 0;  // not part of what is checked here
+  command.fit_ratio = true;         // the default ratios
   const CommandRun run = RunReportCommand(command);
   ASSERT_EQ(run.code, kExitOk) << run.err;
   EXPECT_THAT(run.out, HasSubstr("calibration: best tension point high (chi2 282.7); fitted sigma "
                                  "2.50 +- 0.09 (95 % [2.25, 2.50]), +- 0.00 systematic, "
                                  "chi2/dof 90.9 (poor)"));
+  // a stiffer Buna-N lattice brings feet B and C later, but not far enough
+  EXPECT_THAT(run.out, HasSubstr("stiffness ratio x2.00 (68 % [1.41, 2.00]), sigma 0.00, "
+                                 "chi2 89.9, 2 dof; not determined by these trials (poor)"));
   const std::string section = ReadFile(scratch / "report" / "calibration.md");
   for (const std::string part :
        {"The highest tension point, high, ranks 1 of 5.", "- A: high, med-high, mean",
         "- D: mean, med-high, high, med-low",
         "foot B: the hardware mean 0.572 rad lies above every simulated value",
         "foot C: the hardware mean 0.516 rad lies above every simulated value",
-        "stiffnesses: silicone 263.0 N/m, Buna-N 1139.0 N/m", "Not run (--mc-samples 0)"}) {
+        "stiffnesses: silicone 263.0 N/m, Buna-N 1139.0 N/m", "Not run (--mc-samples 0)",
+        "| 0.50 | +4.000 (edge) | 799.56 |", "| 1.00 | +2.500 | 272.75 |",
+        "| 2.00 | +0.000 | 89.89 |",
+        "the least chi-square lies at the end of the ratios fitted (x2.00"}) {
     EXPECT_THAT(section, HasSubstr(part));
   }
 }
