@@ -26,7 +26,6 @@ namespace liftoff::video {
 namespace {
 
 using internal::FiniteMedian;
-using internal::FiniteQuantile;
 using internal::kGroundTolerancePx;
 using internal::MedianCurve;
 using internal::MovingWithTheOthers;
@@ -1346,12 +1345,11 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
       LiftoffUncertaintyS(track, search, crossing_s, compression_error_px, drift_px);
   // the foot's own patches disagreeing on the crossing (a tiny foot's patches that hold
   // some ground lag it: re-drawn hard3d-04, --seed 5000, at 0.25 px a mm)
-  std::vector<double> t_s(samples.size());
-  for (size_t f = 0; f < samples.size(); ++f) t_s[f] = Seconds(samples[f].t_ns);
-  uncertainty_s = std::hypot(
-      uncertainty_s,
-      internal::PatchCrossingSpreadS(t_s, selection.foot_curves_px, search.fit_first,
-                                     fit.level + track.threshold_px, crossing_s, kSustainFrames));
+  const size_t sustain_frames = std::max<size_t>(kSustainFrames, FramesIn(samples, kSustainS));
+  uncertainty_s = std::hypot(uncertainty_s,
+                             internal::PatchCrossingSpreadS(
+                                 samples, selection.foot_curves_px, search.fit_first,
+                                 fit.level + track.threshold_px, sustain_frames, kSustainFrames));
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =

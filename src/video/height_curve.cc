@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "video_util.h"
 
@@ -191,6 +192,50 @@ Instant SunkCrossing(double rest_s, double crossing_s, double uncertainty_s) {
   const double low_s = std::min(rest_s, crossing_s - uncertainty_s);
   const double high_s = crossing_s + uncertainty_s;
   return {0.5 * (low_s + high_s), 0.5 * (high_s - low_s)};
+}
+
+namespace {
+
+// One patch's crossing for PatchCrossingSpreadS, s; nullopt for none.
+std::optional<double> PatchCrossingS(const std::vector<HeightSample>& samples,
+                                     const std::vector<double>& curve_px, size_t first,
+                                     double level_px, size_t sustain_frames, size_t short_frames) {
+  size_t last = curve_px.size();  // one past the last measured frame
+  while (last > first && !std::isfinite(curve_px[last - 1])) --last;
+  size_t above = 0, start = 0;
+  std::optional<size_t> below;
+  for (size_t f = first; f < last && above < sustain_frames; ++f) {
+    if (!std::isfinite(curve_px[f])) continue;
+    if (curve_px[f] > level_px) {
+      if (above++ == 0) start = f;
+    } else {
+      above = 0;
+      below = f;
+    }
+  }
+  // a run shorter than sustain_frames went on to the patch's last measured frame
+  if (above < std::min(sustain_frames, short_frames) || !below) return std::nullopt;
+  const double t0_s = Seconds(samples[*below].t_ns), t1_s = Seconds(samples[start].t_ns);
+  const double h0_px = curve_px[*below], h1_px = curve_px[start];
+  return t0_s + (t1_s - t0_s) * (level_px - h0_px) / (h1_px - h0_px);
+}
+
+}  // namespace
+
+double PatchCrossingSpreadS(const std::vector<HeightSample>& samples,
+                            const std::vector<std::vector<double>>& curves_px, size_t first,
+                            double level_px, size_t sustain_frames, size_t short_frames) {
+  std::vector<double> crossings_s;
+  for (const std::vector<double>& curve_px : curves_px) {
+    const std::optional<double> crossing_s =
+        PatchCrossingS(samples, curve_px, first, level_px, sustain_frames, short_frames);
+    if (crossing_s && std::isfinite(*crossing_s)) crossings_s.push_back(*crossing_s);
+  }
+  if (crossings_s.size() < 3) return 0.0;
+  std::vector<double> copy = crossings_s;
+  const double middle_s = FiniteMedian(copy);
+  for (double& t_s : crossings_s) t_s = std::abs(t_s - middle_s);
+  return 1.4826 * FiniteMedian(crossings_s);
 }
 
 }  // namespace liftoff::video::internal

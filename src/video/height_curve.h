@@ -133,4 +133,16 @@ CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,
                          const std::vector<double>& height, size_t first, size_t last,
                          double level, double model_s, double model_uncertainty_s);
 
+/// How much the foot's own patches disagree on the crossing of `level_px`, s: 1.4826 times
+/// the median absolute deviation of the patches' own crossings (a robust sigma), with three
+/// patches crossing or more, else 0. A patch crosses before the first of `sustain_frames`
+/// measured frames in a row above the level from frame `first` on (or of at least
+/// `short_frames` up to its last measured frame: a fast foot outruns its patches),
+/// interpolated from its last measured frame at or below the level (strictly above, so the
+/// two frames differ and the line is never flat); one above from `first` on has none.
+/// `curves_px` holds each patch's height per sample (px, NaN where unmeasured).
+double PatchCrossingSpreadS(const std::vector<HeightSample>& samples,
+                            const std::vector<std::vector<double>>& curves_px, size_t first,
+                            double level_px, size_t sustain_frames, size_t short_frames);
+
 }  // namespace liftoff::video::internal

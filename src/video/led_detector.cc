@@ -93,11 +93,12 @@ constexpr size_t kTopPixelsShare = 256;
 constexpr double kPixelNoiseSigmas = 5.0;
 constexpr double kPixelStepFrac = 0.1;
 constexpr double kRoiOppositeFrac = 0.5;
-// But a small light (its strong steps, kRoiStrongFrac of the largest or more, at least
-// kSmallLightShare of them within kSmallLightRadiusPx of the largest) is one when the strong
-// steps the other way stay under that share: a codec renewing a tiny LED's block moves many
-// pixels a little either way, and a few of them strongly (H.264 stepped a pixel 4 px beside
-// hard3d-06's 0.6 px LED, --seed 5000, by a third of the LED's own step).
+// But a small light (its strong steps, kRoiStrongFrac of the largest or more, summing at
+// least kSmallLightShare of their total within the (2 kSmallLightRadiusPx + 1) px square
+// centred on the largest) is one when the strong steps the other way stay under that share: a codec
+// renewing a tiny LED's block moves many pixels a little either way, and a few of them strongly
+// (H.264 stepped a pixel 4 px beside hard3d-06's 0.6 px LED, --seed 5000, by a third of the LED's
+// own step).
 constexpr double kRoiStrongFrac = 0.3;
 constexpr int64_t kSmallLightRadiusPx = 3;
 constexpr double kSmallLightShare = 0.8;

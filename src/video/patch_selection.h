@@ -52,7 +52,8 @@ std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& member
 /// kGroundTolerancePx of its own, is over kOffRestFactor times the candidates' median one
 /// and over kOffRestFloorPx (a patch that slipped up an edge seconds before the liftoff and
 /// stayed there ends as high as the foot, and its offset gave it a gain four times the
-/// others': hard3d-08, --seed 0 and 5000, took it for the foot alone).
+/// others': hard3d-08, --seed 0 and 5000, took it for the foot alone). It cannot tell with
+/// two candidates (their median is their mean) nor when the off-rest ones are half of them.
 template <typename Value>
 std::vector<size_t> MovingWithTheOthers(std::vector<size_t> candidates, size_t first, size_t frames,
                                         const Value& value) {
@@ -99,15 +100,5 @@ std::vector<size_t> MovingWithTheOthers(std::vector<size_t> candidates, size_t f
   }
   return moving;
 }
-
-/// How much the foot's own patches disagree on the crossing of `level`, s: 1.4826 times the
-/// median distance from crossing_s of each patch's own crossing (before the first of
-/// `sustain` measured frames in a row above `level` from frame `first` on, interpolated
-/// from the last measured frame at or below it; a patch that never crosses so, or is above
-/// from the start, has none); 0 with fewer than three. `t_s` holds each frame's time,
-/// `curves` each patch's height per frame (px, NaN where unmeasured).
-double PatchCrossingSpreadS(const std::vector<double>& t_s,
-                            const std::vector<std::vector<double>>& curves, size_t first,
-                            double level, double crossing_s, size_t sustain);
 
 }  // namespace liftoff::video::internal

@@ -529,13 +529,6 @@ TEST(CliSync, VideoModeAndHandInstantsExcludeEachOtherAndOneIsNeeded) {
   }
 }
 
-}  // namespace
-// A 0.6 px LED on its real pixels (tests/video/data/README.md: a lossless crop of an H.264
-// clip liftoff rendered): H.264 builds the spot up over four frames and shows the half-lit
-// frame above half of the step, and the frame before the step's is still dark. Found, within
-// half a frame, the truth inside its interval (before kPartlyLitBeforeFrac: not found).
-namespace {
-
 // The LED of a lossless crop of a hard3d-06 clip (tests/video/data/README.md): its ROI is
 // 98,12,24,24 and it switches on at 0.8 s.
 void ExpectTinyLedFound(const std::string& clip) {
@@ -553,6 +546,10 @@ void ExpectTinyLedFound(const std::string& clip) {
 
 }  // namespace
 
+// A 0.6 px LED on its real pixels (tests/video/data/README.md: a lossless crop of an H.264
+// clip liftoff rendered): H.264 builds the spot up over four frames and shows the half-lit
+// frame above half of the step, and the frame before the step's is still dark. Found, within
+// half a frame, the truth inside its interval (before kPartlyLitBeforeFrac: not found).
 TEST(ClipAnalysis, ATinyLedACodecBuildsUpIsFoundOnItsRealPixels) {
   ExpectTinyLedFound("hard3d-06-seed6000-led.mkv");
 }

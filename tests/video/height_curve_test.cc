@@ -2,6 +2,7 @@
 // follow by hand.
 #include "height_curve.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -12,6 +13,7 @@ namespace liftoff::video::internal {
 namespace {
 
 constexpr double kFrameS = 0.04;  // 25 fps
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::vector<HeightSample> Samples(size_t count) {
   std::vector<HeightSample> samples(count);
@@ -190,6 +192,44 @@ TEST(SurelyAbove, TheFirstSustainedCrossingOfTheLevelPlusTheMargin) {
   // not the excursion: two frames are no sustained crossing
   EXPECT_NEAR(SurelyAboveS(samples, height, 0, 10, 0.5, 0.4), 8 * kFrameS, 1e-12);
   EXPECT_TRUE(std::isnan(SurelyAboveS(samples, height, 0, 10, 0.5, 0.7)));  // never
+}
+
+// A patch at rest, then rising 1 px a frame from frame `from`.
+std::vector<double> RisingFrom(size_t from, size_t frames) {
+  std::vector<double> curve(frames, 0.0);
+  for (size_t f = from; f < frames; ++f) curve[f] = static_cast<double>(f - from);
+  return curve;
+}
+
+TEST(PatchCrossingSpreadS, RobustSigmaOfThePatchesOwnCrossings) {
+  // crossing 2.5 px at frames 12.5, 14.5 and 17.5: their median 14.5, deviations 2, 0 and
+  // 3 frames, median 2 frames
+  const std::vector<std::vector<double>> curves = {RisingFrom(10, 40), RisingFrom(12, 40),
+                                                   RisingFrom(15, 40)};
+  EXPECT_NEAR(PatchCrossingSpreadS(Samples(40), curves, 0, 2.5, 5, 3), 1.4826 * 2 * kFrameS, 1e-9);
+}
+
+TEST(PatchCrossingSpreadS, SpikesDoNotCrossLostFramesAreSkippedAndTwoPatchesGiveNone) {
+  std::vector<double> spiky = RisingFrom(12, 40);
+  spiky[5] = 9.0;  // one frame above: no crossing there
+  std::vector<double> lost = RisingFrom(15, 40);
+  lost[17] = lost[18] = kNaN;  // unmeasured frames neither break nor make a run
+  const std::vector<std::vector<double>> curves = {RisingFrom(10, 40), spiky, lost};
+  EXPECT_NEAR(PatchCrossingSpreadS(Samples(40), curves, 0, 2.5, 5, 3), 1.4826 * 2 * kFrameS, 1e-9);
+  const std::vector<std::vector<double>> two = {RisingFrom(10, 40), RisingFrom(15, 40)};
+  EXPECT_EQ(PatchCrossingSpreadS(Samples(40), two, 0, 2.5, 5, 3), 0.0);
+}
+
+TEST(PatchCrossingSpreadS, APatchLostSoonAfterItsCrossingCountsAndOneNeverCrossingDoesNot) {
+  // the fast patch is lost 3 frames after crossing (short_frames 3), the fourth never rises:
+  // crossings 12.5, 14.5, 17.5 as above
+  std::vector<double> fast = RisingFrom(10, 40);
+  std::fill(fast.begin() + 16, fast.end(), kNaN);
+  const std::vector<std::vector<double>> curves = {fast, RisingFrom(12, 40), RisingFrom(15, 40),
+                                                   std::vector<double>(40, 0.0)};
+  EXPECT_NEAR(PatchCrossingSpreadS(Samples(40), curves, 0, 2.5, 10, 3), 1.4826 * 2 * kFrameS, 1e-9);
+  // with a longer short run asked for, the fast patch does not count: two left
+  EXPECT_EQ(PatchCrossingSpreadS(Samples(40), curves, 0, 2.5, 10, 5), 0.0);
 }
 
 }  // namespace

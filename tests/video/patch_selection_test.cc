@@ -42,12 +42,12 @@ std::vector<double> SlippedPatch(double step_px, size_t lost) {
 }
 
 TEST(MovingWithTheOthers, APatchThatSlippedEarlyAndStayedHighIsNoFoot) {
-  // shaped like hard3d-08's (--seed 0): two patches on the foot at rest, then rising 30 px
-  // over the last 10 frames and lost; a patch that slipped 30 px up an edge early and
-  // stayed there
-  // the slipped patch sits where the foot ends: its offset times the foot's short rise gives
-  // it a gain of about 4, which put both foot patches under half the upper quartile
-  const Curves curves{{FootPatch(1.0, 0.1, 3), FootPatch(1.0, 0.15, 3), SlippedPatch(30.0, 5)}};
+  // shaped like hard3d-08's (--seed 0): two patches on the foot at rest, then rising 3 px a
+  // frame and lost after 4 frames of it (a fast foot outruns them); a patch that slipped
+  // 30 px up an edge early and stayed there. Against their median curve the slipped patch's
+  // gain is 30 * 30 / 270 = 3.3 and the foot's 1, under half the upper quartile (2.2): the
+  // gain test alone keeps the slipped patch alone.
+  const Curves curves{{FootPatch(1.0, 0.1, 6), FootPatch(1.0, 0.1, 6), SlippedPatch(30.0, 6)}};
   EXPECT_EQ(MovingWithTheOthers({0, 1, 2}, 0, kFrames, curves), (std::vector<size_t>{0, 1}));
 }
 
@@ -57,38 +57,6 @@ TEST(MovingWithTheOthers, APatchOnShadowMovingByAFractionIsNoFootAndNoiseLeavesN
   const Curves curves{{FootPatch(1.0, 0.1, 0), FootPatch(1.0, 1.5, 0), FootPatch(1.1, 0.1, 0),
                        FootPatch(0.2, 0.1, 0)}};
   EXPECT_EQ(MovingWithTheOthers({0, 1, 2, 3}, 0, kFrames, curves), (std::vector<size_t>{0, 1, 2}));
-}
-
-// 10 frames a second; a patch at rest, then rising 1 px a frame from frame `from`.
-std::vector<double> RisingFrom(size_t from, size_t frames) {
-  std::vector<double> curve(frames, 0.0);
-  for (size_t f = from; f < frames; ++f) curve[f] = static_cast<double>(f - from);
-  return curve;
-}
-
-std::vector<double> Times(size_t frames) {
-  std::vector<double> t_s(frames);
-  for (size_t f = 0; f < frames; ++f) t_s[f] = 0.1 * static_cast<double>(f);
-  return t_s;
-}
-
-TEST(PatchCrossingSpreadS, RobustSigmaOfThePatchesOwnCrossingsAboutTheFoundOne) {
-  // crossing 2.5 px at frames 12.5, 14.5 and 17.5 (1.25, 1.45, 1.75 s); found at 1.45 s:
-  // distances 0.2, 0 and 0.3 s, median 0.2 s
-  const std::vector<std::vector<double>> curves = {RisingFrom(10, 40), RisingFrom(12, 40),
-                                                   RisingFrom(15, 40)};
-  EXPECT_NEAR(PatchCrossingSpreadS(Times(40), curves, 0, 2.5, 1.45, 5), 1.4826 * 0.2, 1e-9);
-}
-
-TEST(PatchCrossingSpreadS, OneFrameSpikesAndLostFramesDoNotCrossAndTwoPatchesGiveNone) {
-  std::vector<double> spiky = RisingFrom(12, 40);
-  spiky[5] = 9.0;  // one frame above: no crossing there
-  std::vector<double> lost = RisingFrom(15, 40);
-  lost[17] = lost[18] = kNaN;  // unmeasured frames neither break nor make a run
-  const std::vector<std::vector<double>> curves = {RisingFrom(10, 40), spiky, lost};
-  EXPECT_NEAR(PatchCrossingSpreadS(Times(40), curves, 0, 2.5, 1.45, 5), 1.4826 * 0.2, 1e-9);
-  const std::vector<std::vector<double>> two = {RisingFrom(10, 40), RisingFrom(15, 40)};
-  EXPECT_EQ(PatchCrossingSpreadS(Times(40), two, 0, 2.5, 1.45, 5), 0.0);
 }
 
 TEST(MedianCurve, NaNWhereTooFewPatchesAreMeasured) {
