@@ -29,6 +29,7 @@ using internal::FiniteMedian;
 using internal::kGroundTolerancePx;
 using internal::MedianCurve;
 using internal::MovingWithTheOthers;
+using internal::RestingWithTheOthers;
 
 using internal::MedianOf;
 using internal::PatchMatch;
@@ -766,6 +767,16 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   // the foot: the region's patches that end highest ...
   std::vector<std::pair<double, size_t>> finals = FinalRises(region, first, frames, final_count,
                                                              relative);
+  // (rising patches that did not rest with the others before are no foot)
+  std::vector<size_t> rising;
+  for (const auto& [final_rise, p] : finals) {
+    if (final_rise > kGroundTolerancePx) rising.push_back(p);
+  }
+  const std::vector<size_t> resting = RestingWithTheOthers(rising, first, frames, relative);
+  std::erase_if(finals, [&](const std::pair<double, size_t>& f) {
+    return f.first > kGroundTolerancePx &&
+           std::find(resting.begin(), resting.end(), f.second) == resting.end();
+  });
   std::sort(finals.rbegin(), finals.rend());
   if (finals.empty()) return selection;
   const double top = finals[std::min<size_t>(1, finals.size() - 1)].first;

@@ -44,59 +44,64 @@ std::vector<double> MedianCurve(size_t frames, const std::vector<size_t>& member
   return curve;
 }
 
-/// The candidates that move with the others, all the way (frames [first, frames)): each
-/// one's gain against their median curve (least squares); a patch that holds some ground or
-/// shadow moves by a fraction of the foot's motion, one on something else by none of it.
-/// First the candidates that do not rest where the others do are left out: those whose
-/// median distance from their rest level, over the frames where the median curve is within
-/// kGroundTolerancePx of its own, is over kOffRestFactor times the candidates' median one
-/// and over kOffRestFloorPx (a patch that slipped up an edge seconds before the liftoff and
-/// stayed there ends as high as the foot, and its offset gave it a gain four times the
-/// others': hard3d-08, --seed 0 and 5000, took it for the foot alone). It cannot tell with
-/// two candidates (their median is their mean) nor when the off-rest ones are half of them.
+/// The patches that rest where the others rest (frames [first, frames)): those whose median
+/// distance from their rest level, over the frames where the patches' median curve is
+/// within kGroundTolerancePx of its own, is at most kOffRestFactor times the patches' median
+/// one or at most kOffRestFloorPx (a patch that slipped up an edge seconds before the
+/// liftoff and stayed there ends as high as the foot: hard3d-08, --seed 0 and 5000, and
+/// hard3d-02, --seed 7000, took one for the foot alone). It cannot tell with two patches
+/// (their median is their mean) nor when the off-rest ones are half of them.
 template <typename Value>
-std::vector<size_t> MovingWithTheOthers(std::vector<size_t> candidates, size_t first, size_t frames,
-                                        const Value& value) {
-  std::vector<double> common = MedianCurve(frames, candidates, 1, value);
+std::vector<size_t> RestingWithTheOthers(const std::vector<size_t>& patches, size_t first,
+                                         size_t frames, const Value& value) {
+  const std::vector<double> common = MedianCurve(frames, patches, 1, value);
   std::vector<double> off_rest_px;
-  for (size_t p : candidates) {
-    std::vector<double> distances;
+  for (size_t p : patches) {
+    std::vector<double> distances_px;
     for (size_t f = first; f < frames; ++f) {
       const double v = value(f, p);
       if (std::isfinite(v) && std::abs(common[f]) <= kGroundTolerancePx) {
-        distances.push_back(std::abs(v));
+        distances_px.push_back(std::abs(v));
       }
     }
-    off_rest_px.push_back(FiniteMedian(distances));
+    off_rest_px.push_back(FiniteMedian(distances_px));
   }
   std::vector<double> sorted = off_rest_px;
   const double usual_px = FiniteMedian(sorted);
   std::vector<size_t> resting;
-  for (size_t i = 0; i < candidates.size(); ++i) {
+  for (size_t i = 0; i < patches.size(); ++i) {
     if (!(off_rest_px[i] > std::max(kOffRestFactor * usual_px, kOffRestFloorPx))) {
-      resting.push_back(candidates[i]);
+      resting.push_back(patches[i]);
     }
   }
-  if (resting.size() < candidates.size()) {
-    candidates = std::move(resting);
-    common = MedianCurve(frames, candidates, 1, value);
-  }
-  std::vector<double> gains(candidates.size(), 0.0);
-  for (size_t i = 0; i < candidates.size(); ++i) {
+  return resting;
+}
+
+/// The candidates that move with the others, all the way (frames [first, frames)): those
+/// resting with the others (RestingWithTheOthers), then each one's gain against their median
+/// curve (least squares); a patch that holds some ground or shadow moves by a fraction of
+/// the foot's motion, one on something else by none of it.
+template <typename Value>
+std::vector<size_t> MovingWithTheOthers(const std::vector<size_t>& candidates, size_t first,
+                                        size_t frames, const Value& value) {
+  const std::vector<size_t> resting = RestingWithTheOthers(candidates, first, frames, value);
+  const std::vector<double> common = MedianCurve(frames, resting, 1, value);
+  std::vector<double> gains(resting.size(), 0.0);
+  for (size_t i = 0; i < resting.size(); ++i) {
     double product = 0, norm = 0;
     for (size_t f = first; f < frames; ++f) {
-      const double v = value(f, candidates[i]);
+      const double v = value(f, resting[i]);
       if (!std::isfinite(v) || !std::isfinite(common[f])) continue;
       product += v * common[f];
       norm += common[f] * common[f];
     }
     gains[i] = norm > 0 ? product / norm : 0.0;
   }
-  sorted = gains;
+  std::vector<double> sorted = gains;
   const double full = FiniteQuantile(sorted, kFullGainQuantile);
   std::vector<size_t> moving;
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    if (gains[i] >= kFullGainFraction * full) moving.push_back(candidates[i]);
+  for (size_t i = 0; i < resting.size(); ++i) {
+    if (gains[i] >= kFullGainFraction * full) moving.push_back(resting[i]);
   }
   return moving;
 }

@@ -338,6 +338,32 @@ TEST(FootTracker, APartMovedByTheBendAndLostLongBeforeTheLiftoffIsNoFoot) {
   ExpectDrawnLiftoff(DrawnOptions(cv::Rect(70, 50, 60, 52)), 300, draw, 8.0 + std::sqrt(0.005));
 }
 
+TEST(FootTracker, APartThatMovedLongBeforeTheLiftoffAndStayedUpIsNoFoot) {
+  // hand-drawn: a small textured part in the region's top slips 8 px up at 2-2.2 s and
+  // stays there to the clip's end; the foot rises from 8 s and is carried off 0.5 s later,
+  // 25 px up (its patches lost a few frames into the rise), so the part ends higher than
+  // the foot's patches' last levels (re-drawn hard3d-02, --seed 7000, took such a patch for
+  // the foot alone, 12 s early)
+  const cv::Size size(200, 150);
+  const cv::Mat floor = Texture(size, 14, 90, 200), part = Texture(size, 15, 20, 110),
+                foot = Texture(size, 16, 0, 60);
+  cv::Mat part_mask(size, CV_32FC1, cv::Scalar(0)), foot_mask(size, CV_32FC1, cv::Scalar(0));
+  part_mask(cv::Rect(108, 60, 10, 8)).setTo(1.0);
+  cv::circle(foot_mask, cv::Point(96, 90), 12, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
+  const auto slip_px = [](double t_s) { return 8.0 * std::clamp((t_s - 2.0) / 0.2, 0.0, 1.0); };
+  const auto rise_px = [](double t_s) { return t_s > 8.0 ? 100 * (t_s - 8.0) * (t_s - 8.0) : 0.0; };
+  cv::RNG rng(17);
+  cv::Mat covered(size, CV_32FC1);
+  const auto draw = [&](double t_s) {
+    const cv::Mat m = ShiftedUp(part_mask, slip_px(t_s)), f = ShiftedUp(foot_mask, rise_px(t_s));
+    rng.fill(covered, cv::RNG::UNIFORM, 0, 255);
+    const cv::Mat foot_now = t_s < 8.5 ? ShiftedUp(foot, rise_px(t_s)) : covered;
+    const cv::Mat grey = floor.mul(1 - m) + ShiftedUp(part, slip_px(t_s)).mul(m);
+    return cv::Mat(grey.mul(1 - f) + foot_now.mul(f));
+  };
+  ExpectDrawnLiftoff(DrawnOptions(cv::Rect(70, 55, 56, 52)), 300, draw, 8.0 + std::sqrt(0.005));
+}
+
 TEST(FootTracker, AFootOutrunningItsPatchesWidensTheIntervalToTheirCrossing) {
   // hand-drawn: a small foot rises fast from 3 s and is carried off 0.3 s later, 9 px up
   // (its patches lost a few frames into the rise); its shadow on the floor beside it rises
