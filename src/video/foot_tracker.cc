@@ -31,6 +31,7 @@ using internal::MedianCurve;
 using internal::MovingWithTheOthers;
 using internal::RestingWithTheOthers;
 
+using internal::MadSigma;
 using internal::MedianOf;
 using internal::PatchMatch;
 using internal::PatchTemplate;
@@ -572,15 +573,6 @@ std::vector<double> RunningMedian(const std::vector<double>& curve, size_t half)
     out[i] = FiniteMedian(window);
   }
   return out;
-}
-
-// 1.4826 x the median absolute deviation of the finite values; 0 for none.
-double RobustSpread(std::vector<double> values) {
-  const double median = FiniteMedian(values);
-  if (!std::isfinite(median)) return 0;
-  for (double& v : values) v = std::abs(v - median);
-  const double mad = FiniteMedian(values);
-  return std::isfinite(mad) ? 1.4826 * mad : 0.0;
 }
 
 // Frames of `samples` in `seconds` at the clip's median rate (at least 1).
@@ -1232,7 +1224,7 @@ void FillSamples(const PatchSelection& selection, const std::vector<size_t>& res
   std::vector<double> rest_heights;
   for (size_t f : rest) rest_heights.push_back(selection.height_px[f]);
   track.rest_rise_px = 0;
-  track.rest_noise_px = RobustSpread(rest_heights);
+  track.rest_noise_px = MadSigma(rest_heights);
 }
 
 // The model's crossing checked against the curve's own (internal::CheckCrossing). Returns

@@ -14,26 +14,6 @@ double Seconds(int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
 }  // namespace
 
-double FiniteMedian(std::vector<double>& values) {
-  values.erase(
-      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-      values.end());
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  return MedianOf(values.data(), static_cast<std::ptrdiff_t>(values.size()));
-}
-
-double FiniteQuantile(std::vector<double>& values, double q) {
-  values.erase(
-      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-      values.end());
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(values.begin(), values.end());
-  const double at = q * static_cast<double>(values.size() - 1);
-  const auto below = static_cast<size_t>(std::floor(at));
-  const size_t above = std::min(values.size() - 1, below + 1);
-  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
-}
-
 double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
   std::vector<double> after, before;
   for (size_t g = key; g < std::min(curve.size(), key + count); ++g) after.push_back(curve[g]);
@@ -232,10 +212,7 @@ double PatchCrossingSpreadS(const std::vector<HeightSample>& samples,
     if (crossing_s && std::isfinite(*crossing_s)) crossings_s.push_back(*crossing_s);
   }
   if (crossings_s.size() < 3) return 0.0;
-  std::vector<double> copy = crossings_s;
-  const double middle_s = FiniteMedian(copy);
-  for (double& t_s : crossings_s) t_s = std::abs(t_s - middle_s);
-  return 1.4826 * FiniteMedian(crossings_s);
+  return MadSigma(std::move(crossings_s));
 }
 
 }  // namespace liftoff::video::internal

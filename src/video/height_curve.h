@@ -8,15 +8,9 @@
 #include <vector>
 
 #include "liftoff/video/foot_tracker.h"
+#include "robust_stats.h"
 
 namespace liftoff::video::internal {
-
-/// Median of the finite values (reorders and shortens `values`); NaN for none.
-double FiniteMedian(std::vector<double>& values);
-
-/// Quantile q (0..1, linear between order statistics) of the finite values (sorts and
-/// shortens `values`); NaN for none.
-double FiniteQuantile(std::vector<double>& values, double q);
 
 /// The curve's step at frame `key`: the median of the `count` frames from it less that of
 /// the `count` before it (0 where either has no finite value).
@@ -32,7 +26,7 @@ void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start,
                          size_t frames, double quiet_px, std::vector<double>& levelled);
 
 /// How much the curve's key frames scatter where the foot stands still (frames [first,
-/// last)), px: 1.4826 times the median of the absolute changes between consecutive key
+/// last)), px: kMadToSigma times the median of the absolute changes between consecutive key
 /// frames, over the square root of 2 (SuccessiveDifferenceSigma: a slow drift adds only its
 /// change per key frame). A lossy codec copies a still picture between key frames, so a
 /// rest window without one measures no noise at all, while each key frame quantises the
@@ -133,7 +127,7 @@ CurveCheck CheckCrossing(const std::vector<HeightSample>& samples,
                          const std::vector<double>& height, size_t first, size_t last,
                          double level, double model_s, double model_uncertainty_s);
 
-/// How much the foot's own patches disagree on the crossing of `level_px`, s: 1.4826 times
+/// How much the foot's own patches disagree on the crossing of `level_px`, s: kMadToSigma times
 /// the median absolute deviation of the patches' own crossings (a robust sigma), with three
 /// patches crossing or more, else 0. A patch crosses before the first of `sustain_frames`
 /// measured frames in a row above the level from frame `first` on (or of at least

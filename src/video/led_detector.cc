@@ -22,9 +22,11 @@ namespace {
 using internal::ExposureRange;
 using Grid = internal::CellGrid;
 using internal::InstantInterval;
+using internal::kMadToSigma;
 using internal::LitFraction;
 using internal::MeasureCells;
 using internal::MedianOf;
+using internal::OrderQuantileOf;
 using internal::RectText;
 
 // Frames before a step that must be flat.
@@ -165,14 +167,6 @@ std::vector<uint8_t> InnerMask(int width_px, int height_px) {
 
 // Every how many of `count` values a quantile looks at (about kQuantileSamples of them).
 size_t SampleStride(size_t count) { return std::max<size_t>(1, count / kQuantileSamples); }
-
-// The value below which `fraction` of `values` lie (reorders them).
-double QuantileOf(std::vector<double>& values, double fraction) {
-  const auto position = values.begin() + static_cast<std::ptrdiff_t>(
-                                             fraction * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), position, values.end());
-  return *position;
-}
 
 // The shape of a window of a series around a step at its frame `before_count`: the
 // levels before and after (medians), the step between them (positive in the step's
@@ -818,8 +812,10 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
   const auto width = static_cast<size_t>(options.roi_px.width);
   double off_sum = 0.0, on_sum = 0.0;
   MeasurePixelSteps(k, rise, off_sum, on_sum);
-  // a pixel's noise (the median frame-to-frame change is 0.95 sigma for Gaussian noise)
-  const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) / 0.954;
+  // a pixel's noise (the median frame-to-frame change is sqrt(2) / kMadToSigma = 0.954
+  // sigma for Gaussian noise)
+  const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) *
+                       kMadToSigma / std::sqrt(2.0);
   const double largest = *std::max_element(pixel_steps.begin(), pixel_steps.end());
   const double clear = std::max(kPixelNoiseSigmas * sigma, kPixelStepFrac * largest);
   double stepped = 0.0, opposite = 0.0, unclipped = 0.0;
@@ -875,7 +871,7 @@ double LedDetector::Impl::InnerQuantile(double q) {
   for (size_t i = 0; i < pixel_steps.size(); ++i) {
     if (inner[i]) jumps.push_back(std::abs(pixel_steps[i]));
   }
-  return jumps.empty() ? 0.0 : QuantileOf(jumps, q);
+  return jumps.empty() ? 0.0 : OrderQuantileOf(jumps, q);
 }
 
 int64_t LedDetector::Impl::PeriodNs() const {
@@ -908,7 +904,7 @@ double LedDetector::Impl::OutlierJump(int64_t k) {
       jumps.push_back(scale * sharp(before[c], previous[c], next[c], after[c]));
     }
   }
-  return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
+  return kOutlierFactor * OrderQuantileOf(jumps, kOutlierQuantile);
 }
 
 double LedDetector::Impl::OutlierContrast(int64_t k) {
@@ -919,7 +915,7 @@ double LedDetector::Impl::OutlierContrast(int64_t k) {
   for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
     jumps.push_back(std::abs(next[c] / next_gain - previous[c] / previous_gain));
   }
-  return kOutlierFactor * QuantileOf(jumps, kOutlierQuantile);
+  return kOutlierFactor * OrderQuantileOf(jumps, kOutlierQuantile);
 }
 
 void LedDetector::Impl::Evaluate() {

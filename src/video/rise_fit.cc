@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 
+#include "robust_stats.h"
+
 namespace liftoff::video::internal {
 namespace {
 
@@ -18,13 +20,6 @@ constexpr double kLeastRise = 1e-6;
 struct Coefficients {
   double level = 0, slope = 0, curvature = 0;
 };
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
 
 double HuberWeight(double residual, double scale) {
   const double a = std::abs(residual);
@@ -139,15 +134,15 @@ double TimeToRise(const Coefficients& c, double threshold) {
 }
 
 // The robust noise of a series from its successive differences (model-free), at least
-// kNoiseFloor times the threshold. (SuccessiveDifferenceSigma in video_util.h is the same
-// estimator with the mean of the middle two for an even count; this fit's upper middle is
-// kept: the switch moved re-drawn hard3d-06, --seed 3000, from +0.0169 to +0.0263 rad.)
+// kNoiseFloor times the threshold. (SuccessiveDifferenceSigma is the same estimator with
+// the mean of the middle two for an even count; see UpperMedianOf.)
 double DifferenceNoise(const std::vector<double>& height, double threshold) {
   std::vector<double> differences;
   for (size_t i = 1; i < height.size(); ++i) {
     differences.push_back(std::abs(height[i] - height[i - 1]));
   }
-  return std::max(1.4826 * Median(differences) / std::sqrt(2.0), kNoiseFloor * threshold);
+  return std::max(kMadToSigma * UpperMedianOf(differences) / std::sqrt(2.0),
+                  kNoiseFloor * threshold);
 }
 
 // Every knee tried, with its fit; `best` the least loss among the rising fits.
@@ -201,11 +196,12 @@ std::vector<double> BestResiduals(const std::vector<double>& t_s, const std::vec
   return residuals;
 }
 
-// robust standard deviation: 1.4826 times the median absolute value
-double RobustSpread(const std::vector<double>& residuals) {
+// robust standard deviation of residuals about zero: kMadToSigma times their median
+// absolute value
+double ResidualSigma(const std::vector<double>& residuals) {
   std::vector<double> absolute(residuals.size());
   for (size_t i = 0; i < residuals.size(); ++i) absolute[i] = std::abs(residuals[i]);
-  return 1.4826 * Median(absolute);
+  return kMadToSigma * UpperMedianOf(std::move(absolute));
 }
 
 // lag-one correlation of the residuals, clamped to [0, 0.95]
@@ -266,7 +262,7 @@ RiseFit FitRise(const std::vector<double>& t_s, const std::vector<double>& heigh
   KneeSearch search = KneeGrid(t_s);
   if (!FitEveryKnee(t_s, height, lag_free, options.huber_k * noise, options, search)) return fit;
   noise =
-      std::max(RobustSpread(BestResiduals(t_s, height, search)), kNoiseFloor * options.threshold);
+      std::max(ResidualSigma(BestResiduals(t_s, height, search)), kNoiseFloor * options.threshold);
   if (!FitEveryKnee(t_s, height, lag_free, options.huber_k * noise, options, search)) return fit;
   fit.correlation = LagOneCorrelation(BestResiduals(t_s, height, search));
 

@@ -156,8 +156,6 @@ TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
   const std::vector<double> curve = {1, 1, 5, 1, 2, 2, nan, 9, 2};
   EXPECT_EQ(LevelStep(curve, 4, 4), 1.0);  // median {2, 2, 9, 2} - median {1, 1, 5, 1}
   EXPECT_EQ(LevelStep(std::vector<double>(4, nan), 2, 2), 0.0);
-  std::vector<double> values = {3, nan, 1, 2};
-  EXPECT_EQ(FiniteMedian(values), 2.0);
 }
 
 TEST(KeyframeNoise, TheKeyFramesScatterWhereTheFramesBetweenCopyAStillPicture) {

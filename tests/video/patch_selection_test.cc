@@ -67,12 +67,5 @@ TEST(MedianCurve, NaNWhereTooFewPatchesAreMeasured) {
   EXPECT_TRUE(std::isnan(curve[2]));
 }
 
-TEST(FiniteQuantile, LinearBetweenOrderStatisticsSkippingNaN) {
-  std::vector<double> values = {4.0, kNaN, 1.0, 3.0, 2.0};
-  EXPECT_DOUBLE_EQ(FiniteQuantile(values, 0.75), 3.25);
-  std::vector<double> none = {kNaN};
-  EXPECT_TRUE(std::isnan(FiniteQuantile(none, 0.5)));
-}
-
 }  // namespace
 }  // namespace liftoff::video::internal
