@@ -55,9 +55,6 @@ Result<stats::TableFormat> TableFormatFlag(const std::string& text);
 void AddCalibrationFlag(Command& app, CalibrationChoice& choice);
 /// --rule, --gap-threshold, --max-past-end, --max-bad-lines, bound to `lookup`.
 void AddLookupFlags(Command& app, LookupChoice& lookup);
-/// The clip analysis' flags (`video`, `sync --video`): regions, foot, scale, threshold and
-/// exposure, bound to `clip`; returned so a mode flag can require or exclude them.
-std::vector<Flag*> AddClipFlags(Command& app, ClipChoice& clip);
 
 /// LookupChoice as validated sync::LookupOptions (kInvalidArgument naming the flag).
 Result<sync::LookupOptions> LookupOptionsFrom(const LookupChoice& choice);

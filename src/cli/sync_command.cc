@@ -51,7 +51,7 @@ Status CheckInstantSources(const SyncCommand& command) {
     return InvalidArgumentError("no video instants: give --led-on S --liftoff S, or --video CLIP "
                                 "--foot-roi x,y,w,h to find them");
   }
-  if (from_video && command.clip.foot_roi.empty()) {
+  if (from_video && command.clip.foot.foot_roi_px.empty()) {
     return InvalidArgumentError(
         "--video needs --foot-roi x,y,w,h: the liftoff comes from the foot");
   }
@@ -121,7 +121,7 @@ int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err) {
   std::optional<video::ClipAnalysisOptions> clip_options;
   std::optional<VideoProgress> progress;
   if (from_video) {
-    auto options = ClipOptionsFrom(command.clip);
+    auto options = CheckedClipOptions(command.clip);
     if (!options.ok()) return ReportError(options.status(), err);
     clip_options = std::move(options).value();
     auto created = VideoProgress::Create(command.progress, err);

@@ -47,30 +47,6 @@ Result<cv::Rect> RectFlag(std::string_view text, std::string_view flag) {
   return cv::Rect(values[0], values[1], values[2], values[3]);
 }
 
-// "FROM,TO" seconds
-Result<std::pair<double, double>> ParseRestWindow(const std::string& text) {
-  const size_t comma = text.find(',');
-  const auto fail = [&] {
-    return InvalidArgumentError(
-        "--rest-window: expected FROM,TO in seconds relative to the LED switch-on, FROM < TO, "
-        "each in [-60, 60] (e.g. -0.5,0), got \"" +
-        text + "\"");
-  };
-  if (comma == std::string::npos) return fail();
-  try {
-    size_t used_from = 0, used_to = 0;
-    const std::string from_text = text.substr(0, comma);
-    const std::string to_text = text.substr(comma + 1);
-    const double from_s = std::stod(from_text, &used_from);
-    const double to_s = std::stod(to_text, &used_to);
-    if (used_from != from_text.size() || used_to != to_text.size()) return fail();
-    if (!(from_s < to_s) || from_s < -60.0 || to_s > 60.0) return fail();
-    return std::pair{from_s, to_s};
-  } catch (const std::exception&) {
-    return fail();
-  }
-}
-
 // the analysis for people
 void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
   out << analysis.video_path.string() << " (" << analysis.width_px << "x" << analysis.height_px
@@ -109,45 +85,99 @@ void PrintAnalysis(const video::ClipAnalysis& analysis, std::ostream& out) {
 // ---------------------------------------------------------------------------------------
 // a clip analysis' flags
 
-Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice) {
-  video::ClipAnalysisOptions options;
-  if (!choice.led_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.led.roi_px, RectFlag(choice.led_roi, "--led-roi"));
-  }
-  if (!choice.foot_roi.empty()) {
-    LIFTOFF_ASSIGN_OR_RETURN(options.foot.foot_roi_px,
-                             RectFlag(choice.foot_roi, "--foot-roi"));
-  }
-  if (!choice.foot.empty()) {
-    const std::optional<Foot> foot = ParseFoot(choice.foot);
-    if (!foot) {
-      return InvalidArgumentError("--foot: expected A, B, C or D, got \"" + choice.foot + "\"");
-    }
-    options.foot.tape_colour = *foot;
-  }
-  options.foot.px_per_mm = choice.px_per_mm;
-  options.foot.threshold_mm = choice.threshold_mm;
-  options.foot.threshold_px = choice.threshold_px;
-  options.led.exposure_s = 1e-3 * choice.exposure_ms;
-  options.foot.exposure_s = options.led.exposure_s;
-  LIFTOFF_ASSIGN_OR_RETURN(const auto rest, ParseRestWindow(choice.rest_window));
-  options.rest_from_led_s = rest.first;
-  options.rest_to_led_s = rest.second;
-  const std::optional<video::LiftoffInstant> instant = video::ParseLiftoffInstant(choice.liftoff);
-  if (!instant) {
-    return InvalidArgumentError("--liftoff: expected threshold or onset, got \"" + choice.liftoff +
-                                "\"");
-  }
-  options.liftoff = *instant;
-  const Status valid = options.Validate();
-  for (const char* field : {"led.exposure_s", "foot.exposure_s"}) {
-    if (auto named = MessageNamingFlag(valid.message(), "--exposure-ms", field, true)) {
-      return Status(valid.code(), *named);
-    }
-  }
-  LIFTOFF_RETURN_IF_ERROR(NameFlagsIn(valid, {{"--px-per-mm", "foot.px_per_mm"},
-                                              {"--threshold-mm", "foot.threshold_mm"},
-                                              {"--threshold-px", "foot.threshold_px"}}));
+namespace {
+
+using ClipOptions = video::ClipAnalysisOptions;
+
+// a region as its flag gives it ("x,y,w,h"); "" for none
+std::string RegionText(const cv::Rect& region) {
+  if (region.empty()) return "";
+  return std::to_string(region.x) + "," + std::to_string(region.y) + "," +
+         std::to_string(region.width) + "," + std::to_string(region.height);
+}
+
+// a region flag bound to the region `access` gives
+template <typename Access>
+FieldFlag<ClipOptions> RegionFlag(std::string flag, std::string field, Access access,
+                                  std::string help) {
+  return TextFlagOf<ClipOptions>(
+      flag, std::move(field),
+      [access](const ClipOptions& options) { return RegionText(access(options)); },
+      [flag, access](ClipOptions& options, const std::string& text) -> Status {
+        LIFTOFF_ASSIGN_OR_RETURN(access(options), RectFlag(text, flag));
+        return Status::Ok();
+      },
+      "x,y,w,h", std::move(help));
+}
+
+std::vector<std::pair<std::string, Foot>> FootWords() {
+  std::vector<std::pair<std::string, Foot>> words;
+  for (Foot foot : kAllFeet) words.emplace_back(std::string(FootName(foot)), foot);
+  return words;
+}
+
+// --rest-window FROM,TO: both ends of the rest window
+FieldFlag<ClipOptions> RestWindowFlag() {
+  FieldFlag<ClipOptions> flag = NumbersFlag<ClipOptions>(
+      "--rest-window", "rest_from_led_s", 2,
+      [](const ClipOptions& options) {
+        return std::vector<double>{options.rest_from_led_s, options.rest_to_led_s};
+      },
+      [](ClipOptions& options, const std::vector<double>& from_to_s) {
+        options.rest_from_led_s = from_to_s[0];
+        options.rest_to_led_s = from_to_s[1];
+      },
+      "FROM,TO", "Foot rest window FROM,TO in s from the LED switch-on (write --rest-window=-1,0)");
+  flag.scaled = true;  // two fields: the message keeps the field's name after the flag's
+  flag.more_fields = {"rest_to_led_s"};
+  return flag;
+}
+
+}  // namespace
+
+const std::vector<FieldFlag<video::ClipAnalysisOptions>>& ClipFlags() {
+  using O = ClipOptions;
+  static const std::vector<FieldFlag<O>> flags = {
+      RegionFlag("--led-roi", LIFTOFF_FIELD(led.roi_px),
+                 "LED region x,y,w,h in pixels (default: located automatically)"),
+      RegionFlag("--foot-roi", LIFTOFF_FIELD(foot.foot_roi_px),
+                 "Foot region x,y,w,h in pixels: the foot at rest and room above it (without "
+                 "it: the LED only)"),
+      ChoiceFlag<O>("--foot", LIFTOFF_FIELD(foot.tape_colour), FootWords(),
+                    "Check that the tracked foot shows this foot's tape colour"),
+      NumberFlag<O>("--px-per-mm", LIFTOFF_FIELD(foot.px_per_mm), kSameUnit,
+                    "Image scale at the foot, px per mm (0: from the foot's width)"),
+      NumberFlag<O>("--threshold-mm", LIFTOFF_FIELD(foot.threshold_mm), kSameUnit,
+                    "Liftoff threshold above rest, mm"),
+      NumberFlag<O>("--threshold-px", LIFTOFF_FIELD(foot.threshold_px), kSameUnit,
+                    "Liftoff threshold above rest, px, in (0, 1000] (instead of "
+                    "--threshold-mm)"),
+      NumberFlag<O>("--exposure-ms", LIFTOFF_FIELD(led.exposure_s), kMillisecondsForSeconds,
+                    "Camera exposure per frame, ms, at most the frame interval (0: unknown; "
+                    "the LED then allows any exposure up to the frame interval, the foot takes "
+                    "half the frame interval)"),
+  };
+  return flags;
+}
+
+const std::vector<FieldFlag<video::ClipAnalysisOptions>>& ClipInstantFlags() {
+  using O = ClipOptions;
+  static const std::vector<FieldFlag<O>> flags = {
+      RestWindowFlag(),
+      ChoiceFlag<O>("--liftoff", LIFTOFF_FIELD(liftoff),
+                    std::vector<std::pair<std::string, video::LiftoffInstant>>{
+                        {"threshold", video::LiftoffInstant::kThreshold},
+                        {"onset", video::LiftoffInstant::kOnset}},
+                    "Liftoff instant"),
+  };
+  return flags;
+}
+
+Result<video::ClipAnalysisOptions> CheckedClipOptions(video::ClipAnalysisOptions options) {
+  options.foot.exposure_s = options.led.exposure_s;  // --exposure-ms: the camera's, for both
+  Status valid = NameFlagIn(options.Validate(), ClipFlags());
+  valid = NameFlagIn(valid, ClipInstantFlags());
+  if (!valid.ok()) return valid;
   return options;
 }
 
@@ -196,7 +226,7 @@ Result<video::ClipAnalysis> AnalyzeClipShowingProgress(const std::filesystem::pa
 // liftoff video
 
 int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err) {
-  auto options = ClipOptionsFrom(command.clip);
+  auto options = CheckedClipOptions(command.clip);
   if (!options.ok()) return ReportError(options.status(), err);
   auto progress = VideoProgress::Create(command.progress, err);
   if (!progress.ok()) return ReportError(progress.status(), err);
@@ -311,33 +341,16 @@ TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysi
 // ---------------------------------------------------------------------------------------
 // the flags
 
-std::vector<Flag*> AddClipFlags(Command& app, ClipChoice& clip) {
-  std::vector<Flag*> options;
-  options.push_back(app.AddOption("--led-roi", clip.led_roi,
-                                  "LED region x,y,w,h in pixels (default: located automatically)"));
-  options.push_back(app.AddOption("--foot-roi", clip.foot_roi,
-                                   "Foot region x,y,w,h in pixels: the foot at rest and room "
-                                   "above it (without it: the LED only)"));
-  options.push_back(
-      app.AddOption("--foot", clip.foot,
-                    "Check that the tracked foot shows this foot's tape colour: A, B, C or D"));
-  options.push_back(app.AddOption("--px-per-mm", clip.px_per_mm,
-                                   "Image scale at the foot, px per mm (0: from the foot's width)")
-                        ->ShowDefault());
-  Flag* threshold_mm =
-      app.AddOption("--threshold-mm", clip.threshold_mm, "Liftoff threshold above rest, mm")
-          ->ShowDefault();
-  options.push_back(threshold_mm);
-  options.push_back(app.AddOption("--threshold-px", clip.threshold_px,
-                                   "Liftoff threshold above rest, px, in (0, 1000] (instead "
-                                   "of --threshold-mm)")
-                        ->Excludes(threshold_mm));
-  options.push_back(app.AddOption("--exposure-ms", clip.exposure_ms,
-                                   "Camera exposure per frame, ms, at most the frame interval "
-                                   "(0: unknown; the LED then allows any exposure up to the "
-                                   "frame interval, the foot takes half the frame interval)")
-                        ->ShowDefault());
-  return options;
+std::vector<Flag*> AddClipFlags(Command& app, video::ClipAnalysisOptions& clip) {
+  std::vector<Flag*> added;
+  Flag *threshold_mm = nullptr, *threshold_px = nullptr;
+  for (const FieldFlag<video::ClipAnalysisOptions>& flag : ClipFlags()) {
+    added.push_back(flag.add(app, clip));
+    if (flag.flag == "--threshold-mm") threshold_mm = added.back();
+    if (flag.flag == "--threshold-px") threshold_px = added.back();
+  }
+  threshold_px->Excludes(threshold_mm);
+  return added;
 }
 
 Subcommand AddVideoCommand(Command& parent) {
@@ -346,12 +359,7 @@ Subcommand AddVideoCommand(Command& parent) {
       "video", "Find the LED switch-on and the foot's liftoff in one clip, with proof");
   app->AddOption("clip", command->video_path, "Video file")->Required();
   AddClipFlags(*app, command->clip);
-  app->AddOption("--rest-window", command->clip.rest_window,
-                  "Foot rest window FROM,TO in s from the LED switch-on (write "
-                  "--rest-window=-1,0)")
-      ->ShowDefault();
-  app->AddOption("--liftoff", command->clip.liftoff, "Liftoff instant: threshold or onset")
-      ->ShowDefault();
+  AddFlags(*app, ClipInstantFlags(), command->clip);
   app->AddOption("--verify", command->verify_path, "Write a verification image (PNG)");
   app->AddOption("--annotate", command->annotate_path,
                   "Write the clip with the detections drawn (Motion JPEG AVI)");

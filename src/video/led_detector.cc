@@ -10,10 +10,11 @@
 #include <optional>
 #include <utility>
 
-#include "liftoff/core/text.h"
-#include "liftoff/core/time.h"
 #include "cell_sums.h"
 #include "led_timing.h"
+#include "liftoff/core/json.h"
+#include "liftoff/core/text.h"
+#include "liftoff/core/time.h"
 #include "video_util.h"
 
 namespace liftoff::video {
@@ -257,7 +258,7 @@ Status LedDetector::Options::Validate() const {
   }
   if (!(threshold_frac > 0.0 && threshold_frac < 1.0)) {
     return InvalidArgumentError("threshold_frac: expected 0 < x < 1, got " +
-                                std::to_string(threshold_frac));
+                                FormatNumber(threshold_frac));
   }
   if (min_on_frames < 1 || min_on_frames > 100) {
     return InvalidArgumentError("min_on_frames: expected 1 .. 100, got " +
@@ -265,15 +266,15 @@ Status LedDetector::Options::Validate() const {
   }
   if (!(min_contrast_levels > 0.0 && min_contrast_levels <= 255.0)) {
     return InvalidArgumentError("min_contrast_levels: expected 0 < x <= 255, got " +
-                                std::to_string(min_contrast_levels));
+                                FormatNumber(min_contrast_levels));
   }
   if (!(dim_warning_levels >= min_contrast_levels && dim_warning_levels <= 255.0)) {
     return InvalidArgumentError("dim_warning_levels: expected min_contrast_levels .. 255, got " +
-                                std::to_string(dim_warning_levels));
+                                FormatNumber(dim_warning_levels));
   }
   if (!(exposure_s >= 0.0 && exposure_s <= 1.0)) {
     return InvalidArgumentError("exposure_s: expected 0 (unknown) .. 1 s, got " +
-                                std::to_string(exposure_s));
+                                FormatNumber(exposure_s));
   }
   return Status::Ok();
 }

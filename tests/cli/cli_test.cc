@@ -14,6 +14,7 @@
 
 #include "liftoff/cli/capture_commands.h"
 #include "liftoff/cli/commands.h"
+#include "liftoff/cli/video_commands.h"
 #include "liftoff/core/json.h"
 #include "support/test_support.h"
 

@@ -116,39 +116,112 @@ TEST(CommandLine, ExperimentFlagsShowTheExperimentsDefaultsInTheirUnits) {
   }
 }
 
-TEST(ClipOptionsFrom, ReadsRegionsAsXYWHAndNamesTheFlagOtherwise) {
-  ClipChoice choice;
-  choice.led_roi = "563,45,26,27";
-  choice.foot_roi = "300,520,160,120";
-  auto options = ClipOptionsFrom(choice);
-  ASSERT_TRUE(options.ok()) << options.status().ToString();
-  EXPECT_EQ(options->led.roi_px, cv::Rect(563, 45, 26, 27));
-  EXPECT_EQ(options->foot.foot_roi_px, cv::Rect(300, 520, 160, 120));
+TEST(ClipFlags, BindEachFlagToItsField) {
+  video::ClipAnalysisOptions options;
+  CLI::App app;
+  Command root(&app);
+  AddClipFlags(root, options);
+  AddFlags(root, ClipInstantFlags(), options);
+  std::vector<std::string> arguments = {"--led-roi",
+                                        "563,45,26,27",
+                                        "--foot-roi",
+                                        "300,520,160,120",
+                                        "--foot",
+                                        "C",
+                                        "--px-per-mm",
+                                        "1.5",
+                                        "--threshold-px",
+                                        "2.5",
+                                        "--exposure-ms",
+                                        "8",
+                                        "--rest-window=-1,0.25",
+                                        "--liftoff",
+                                        "onset"};
+  std::reverse(arguments.begin(), arguments.end());
+  app.parse(arguments);
+  auto checked = CheckedClipOptions(options);
+  ASSERT_TRUE(checked.ok()) << checked.status().ToString();
+  EXPECT_EQ(checked->led.roi_px, cv::Rect(563, 45, 26, 27));
+  EXPECT_EQ(checked->foot.foot_roi_px, cv::Rect(300, 520, 160, 120));
+  EXPECT_EQ(checked->foot.tape_colour, Foot::kC);
+  EXPECT_EQ(checked->foot.px_per_mm, 1.5);
+  EXPECT_EQ(checked->foot.threshold_px, 2.5);
+  EXPECT_DOUBLE_EQ(checked->led.exposure_s, 0.008);
+  EXPECT_DOUBLE_EQ(checked->foot.exposure_s, 0.008) << "the camera's exposure, for the foot too";
+  EXPECT_EQ(checked->rest_from_led_s, -1.0);
+  EXPECT_EQ(checked->rest_to_led_s, 0.25);
+  EXPECT_EQ(checked->liftoff, video::LiftoffInstant::kOnset);
+  // written back as they were given
+  std::string described = DescribeChanged(ClipFlags(), options);
+  EXPECT_EQ(described,
+            "--led-roi 563,45,26,27 --foot-roi 300,520,160,120 --foot C --px-per-mm 1.5 "
+            "--threshold-px 2.5 --exposure-ms 8");
+  EXPECT_EQ(DescribeChanged(ClipInstantFlags(), options), "--rest-window=-1,0.25 --liftoff onset");
+}
+
+// A bad value: the parse or the check names the flag.
+TEST(ClipFlags, ABadValueNamesItsFlag) {
+  const auto error = [](std::vector<std::string> arguments) -> std::string {
+    video::ClipAnalysisOptions options;
+    CLI::App app;
+    Command root(&app);
+    AddClipFlags(root, options);
+    AddFlags(root, ClipInstantFlags(), options);
+    std::reverse(arguments.begin(), arguments.end());
+    try {
+      app.parse(arguments);
+    } catch (const FlagError& failure) {
+      return failure.status().message();
+    } catch (const CLI::ParseError& failure) {
+      return failure.what();
+    }
+    auto checked = CheckedClipOptions(options);
+    return checked.ok() ? "" : checked.status().message();
+  };
   for (const char* bad : {"1,2,3", "1,2,3,4,5", "1,2,0,4", "-1,2,3,4", "a,b,c,d", "1,2,3,4 "}) {
-    choice.foot_roi = bad;
-    auto parsed = ClipOptionsFrom(choice);
-    EXPECT_EQ(parsed.status().code(), StatusCode::kInvalidArgument) << bad;
-    EXPECT_THAT(parsed.status().message(), ::testing::HasSubstr("--foot-roi: expected x,y,w,h"))
+    EXPECT_THAT(error({"--foot-roi", bad}), ::testing::HasSubstr("--foot-roi: expected x,y,w,h"))
         << bad;
   }
+  EXPECT_THAT(error({"--foot", "E"}), ::testing::HasSubstr("--foot: expected A, B, C or D"));
+  EXPECT_THAT(error({"--liftoff", "soon"}),
+              ::testing::HasSubstr("--liftoff: expected threshold or onset"));
+  EXPECT_THAT(error({"--px-per-mm", "-1"}), ::testing::HasSubstr("--px-per-mm: expected"));
+  EXPECT_THAT(
+      error({"--exposure-ms", "2000"}),
+      ::testing::HasSubstr("--exposure-ms: led: exposure_s: expected 0 (unknown) .. 1 s, got 2"));
+  EXPECT_THAT(error({"--rest-window=0.5,0"}),
+              ::testing::HasSubstr("--rest-window: rest_to_led_s: expected more than"));
+  EXPECT_THAT(error({"--rest-window=-70,0"}),
+              ::testing::HasSubstr("--rest-window: rest_from_led_s: expected"));
+  EXPECT_THAT(error({"--rest-window=1"}), ::testing::HasSubstr("--rest-window: expected FROM,TO"));
+  EXPECT_THAT(error({"--threshold-mm", "1", "--threshold-px", "2"}),
+              ::testing::HasSubstr("excludes"));
 }
 
 // The clip flags' defaults are the options' own: no flag given, no field changed.
-TEST(ClipOptionsFrom, NoFlagGivenLeavesEveryOptionAtItsDefault) {
-  auto options = ClipOptionsFrom(ClipChoice{});
-  ASSERT_TRUE(options.ok()) << options.status().ToString();
+TEST(ClipFlags, NoFlagGivenLeavesEveryOptionAtItsDefault) {
+  video::ClipAnalysisOptions options;
+  CLI::App app;
+  Command root(&app);
+  AddClipFlags(root, options);
+  AddFlags(root, ClipInstantFlags(), options);
+  app.parse(std::vector<std::string>{});
+  auto checked = CheckedClipOptions(options);
+  ASSERT_TRUE(checked.ok()) << checked.status().ToString();
   const video::ClipAnalysisOptions defaults;
-  EXPECT_EQ(options->led.roi_px, defaults.led.roi_px);
-  EXPECT_EQ(options->led.exposure_s, defaults.led.exposure_s);
-  EXPECT_EQ(options->foot.foot_roi_px, defaults.foot.foot_roi_px);
-  EXPECT_EQ(options->foot.tape_colour, defaults.foot.tape_colour);
-  EXPECT_EQ(options->foot.px_per_mm, defaults.foot.px_per_mm);
-  EXPECT_EQ(options->foot.threshold_mm, defaults.foot.threshold_mm);
-  EXPECT_EQ(options->foot.threshold_px, defaults.foot.threshold_px);
-  EXPECT_EQ(options->foot.exposure_s, defaults.foot.exposure_s);
-  EXPECT_EQ(options->rest_from_led_s, defaults.rest_from_led_s);
-  EXPECT_EQ(options->rest_to_led_s, defaults.rest_to_led_s);
-  EXPECT_EQ(options->liftoff, defaults.liftoff);
+  EXPECT_EQ(checked->led.roi_px, defaults.led.roi_px);
+  EXPECT_EQ(checked->led.exposure_s, defaults.led.exposure_s);
+  EXPECT_EQ(checked->foot.foot_roi_px, defaults.foot.foot_roi_px);
+  EXPECT_EQ(checked->foot.tape_colour, defaults.foot.tape_colour);
+  EXPECT_EQ(checked->foot.px_per_mm, defaults.foot.px_per_mm);
+  EXPECT_EQ(checked->foot.threshold_mm, defaults.foot.threshold_mm);
+  EXPECT_EQ(checked->foot.threshold_px, defaults.foot.threshold_px);
+  EXPECT_EQ(checked->foot.exposure_s, defaults.foot.exposure_s);
+  EXPECT_EQ(checked->rest_from_led_s, defaults.rest_from_led_s);
+  EXPECT_EQ(checked->rest_to_led_s, defaults.rest_to_led_s);
+  EXPECT_EQ(checked->liftoff, defaults.liftoff);
+  EXPECT_EQ(DescribeChanged(ClipFlags(), options), "");
+  EXPECT_EQ(DescribeChanged(ClipInstantFlags(), options), "");
 }
 
 }  // namespace

@@ -90,56 +90,6 @@ struct Import2018Command {
 };
 int RunImport2018(const Import2018Command& command, std::ostream& out, std::ostream& err);
 
-/// A clip analysis' flags as typed (`liftoff video`, `liftoff sync --video`);
-/// ClipOptionsFrom (video_commands.h) checks them and makes video::ClipAnalysisOptions.
-struct ClipChoice {
-  /// Regions "x,y,w,h", px. LED: empty = locate automatically. Foot: empty = LED only.
-  std::string led_roi;
-  std::string foot_roi;
-  /// The foot whose tape colour to track (A, B, C, D); empty: edges only.
-  std::string foot;
-  /// Image scale at the foot, px per mm; 0: estimated from the foot's width.
-  double px_per_mm = 0.0;
-  /// Liftoff threshold above rest: mm (with the scale), or px when threshold_px is given
-  /// (> 0; then threshold_mm is ignored).
-  double threshold_mm = 1.0;
-  std::optional<double> threshold_px;
-  /// Camera exposure per frame, ms (> 0, at most 1.05 frame intervals); 0: unknown (the
-  /// LED allows any exposure up to the frame interval, the foot takes half of it).
-  double exposure_ms = 0.0;
-  /// Rest window "FROM,TO", s relative to the LED switch-on.
-  std::string rest_window = "-0.5,0";
-  /// Which foot instant is the liftoff: "threshold" or "onset".
-  std::string liftoff = "threshold";
-};
-
-/// `liftoff sync LOG --led-on S --liftoff S` or `liftoff sync LOG --video CLIP ...`: one
-/// lookup, the rotation at liftoff. The two video instants come either from the command
-/// line or from the clip's analysis (exactly one of the two).
-struct SyncCommand {
-  std::filesystem::path log_path;
-  /// "auto", "liftoff", "laika-2018".
-  std::string log_format = "auto";
-  CalibrationChoice calibration;
-  LookupChoice lookup;
-  /// Video instants, seconds from the video's start (both, or neither with video_path).
-  std::optional<double> led_on_s;
-  std::optional<double> liftoff_s;
-  /// Half-width of each instant's timing uncertainty, seconds (with led_on_s/liftoff_s).
-  double uncertainty_s = 0.0;
-  /// The clip whose analysis gives the instants and their uncertainties; needs
-  /// clip.foot_roi.
-  std::filesystem::path video_path;
-  ClipChoice clip;
-  /// With video_path: verification image (PNG) to write; empty: none.
-  std::filesystem::path verify_path;
-  /// With video_path: progress on stderr, "auto", "live", "lines" or "off" (as `liftoff
-  /// video`).
-  std::string progress = "auto";
-  bool json = false;
-};
-int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err);
-
 /// `liftoff log LOG`: what a log holds (span, rate, gaps, LED, skipped lines); optionally
 /// converts it to liftoff's format.
 struct LogCommand {
@@ -165,7 +115,6 @@ int RunCalib(const CalibCommand& command, std::ostream& out, std::ostream& err);
 /// struct of its own (defaults: the struct's), run by the returned Subcommand.
 Subcommand AddTableCommand(Command& parent);
 Subcommand AddImport2018Command(Command& parent);
-Subcommand AddSyncCommand(Command& parent);
 Subcommand AddLogCommand(Command& parent);
 Subcommand AddCalibCommand(Command& parent);
 

@@ -127,6 +127,7 @@ struct FlagUnit {
 inline constexpr FlagUnit kSameUnit{1.0};
 inline constexpr FlagUnit kMillimetresForMetres{1e3};
 inline constexpr FlagUnit kDegreesForRadians{180.0 / std::numbers::pi};
+inline constexpr FlagUnit kMillisecondsForSeconds{1e3};
 
 /// One flag bound to one field of `Options`.
 template <typename Options>
@@ -143,6 +144,9 @@ struct FieldFlag {
   std::function<Flag*(Command& app, Options& options)> add;
   /// The field's value as the flag writes it; empty when unset (an empty optional).
   std::function<std::string(const Options& options)> text;
+  /// Further fields the flag writes, named in Validate()'s messages like `field` (with
+  /// the flag in front: "--rest-window: rest_to_led_s: expected ...").
+  std::vector<std::string> more_fields = {};
 };
 
 /// The field's name and an accessor for it, for the Flag factories below:
@@ -231,6 +235,27 @@ FieldFlag<Options> ChoiceFlagOf(std::string flag, std::string field,
         help);
     return option->TypeName(Join(names, "|"))
         ->ShowDefaultFrom([&options, text] { return text(options); });
+  };
+  return bound;
+}
+
+/// A flag whose text `set` parses into the struct (a kInvalidArgument status naming the
+/// flag when it cannot: thrown as FlagError); `get` writes the field back as the flag would
+/// give it ("" when unset). `type_name` names the value in help ("x,y,w,h").
+template <typename Options>
+FieldFlag<Options> TextFlagOf(std::string flag, std::string field,
+                              std::function<std::string(const Options&)> get,
+                              std::function<Status(Options&, const std::string&)> set,
+                              std::string type_name, std::string help) {
+  FieldFlag<Options> bound{flag, std::move(field), false, false, {}, get};
+  bound.add = [flag, help, type_name, set, get](Command& app, Options& options) {
+    Flag* option = app.AddOptionFunction<std::string>(
+        flag,
+        [set, &options](const std::string& given) {
+          if (Status parsed = set(options, given); !parsed.ok()) throw FlagError(parsed);
+        },
+        help);
+    return option->TypeName(type_name)->ShowDefaultFrom([&options, get] { return get(options); });
   };
   return bound;
 }
@@ -326,6 +351,11 @@ Status NameFlagIn(const Status& status, const std::vector<FieldFlag<Options>>& f
   for (const FieldFlag<Options>& flag : flags) {
     if (auto message = MessageNamingFlag(status.message(), flag.flag, flag.field, flag.scaled)) {
       return Status(status.code(), *message);
+    }
+    for (const std::string& field : flag.more_fields) {
+      if (auto message = MessageNamingFlag(status.message(), flag.flag, field, true)) {
+        return Status(status.code(), *message);
+      }
     }
   }
   return status;

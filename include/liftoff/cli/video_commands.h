@@ -26,7 +26,8 @@ namespace liftoff::cli {
 /// liftoff; text, or the analysis as JSON (docs/video.md, "JSON output").
 struct VideoCommand {
   std::filesystem::path video_path;
-  ClipChoice clip;
+  /// The clip analysis' options as the flags give them (CheckedClipOptions checks them).
+  video::ClipAnalysisOptions clip;
   /// Verification image (PNG) and annotated video (MJPG AVI) to write; empty: none.
   std::filesystem::path verify_path;
   std::filesystem::path annotate_path;
@@ -37,8 +38,46 @@ struct VideoCommand {
 };
 int RunVideo(const VideoCommand& command, std::ostream& out, std::ostream& err);
 
-/// The flags of a clip analysis as its options; kInvalidArgument naming the flag.
-Result<video::ClipAnalysisOptions> ClipOptionsFrom(const ClipChoice& choice);
+/// The clip analysis' flags (`video`, `sync --video`), bound to video::ClipAnalysisOptions:
+/// regions, foot, scale, threshold and exposure (--exposure-ms writes led.exposure_s;
+/// CheckedClipOptions gives the foot the same).
+const std::vector<FieldFlag<video::ClipAnalysisOptions>>& ClipFlags();
+/// `liftoff video`'s further clip flags: the rest window and which instant is the liftoff.
+const std::vector<FieldFlag<video::ClipAnalysisOptions>>& ClipInstantFlags();
+/// ClipFlags bound to `clip` on `app` (--threshold-px excluding --threshold-mm); returned so
+/// a mode flag can require them.
+std::vector<Flag*> AddClipFlags(Command& app, video::ClipAnalysisOptions& clip);
+/// The options as the flags left them, the camera's exposure given to the foot too, checked
+/// by Validate(); kInvalidArgument naming the flag.
+Result<video::ClipAnalysisOptions> CheckedClipOptions(video::ClipAnalysisOptions options);
+
+/// `liftoff sync LOG --led-on S --liftoff S` or `liftoff sync LOG --video CLIP ...`: one
+/// lookup, the rotation at liftoff. The two video instants come either from the command
+/// line or from the clip's analysis (exactly one of the two).
+struct SyncCommand {
+  std::filesystem::path log_path;
+  /// "auto", "liftoff", "laika-2018".
+  std::string log_format = "auto";
+  CalibrationChoice calibration;
+  LookupChoice lookup;
+  /// Video instants, seconds from the video's start (both, or neither with video_path).
+  std::optional<double> led_on_s;
+  std::optional<double> liftoff_s;
+  /// Half-width of each instant's timing uncertainty, seconds (with led_on_s/liftoff_s).
+  double uncertainty_s = 0.0;
+  /// The clip whose analysis gives the instants and their uncertainties; needs
+  /// clip.foot.foot_roi_px.
+  std::filesystem::path video_path;
+  /// The clip analysis' options as the flags give them (CheckedClipOptions checks them).
+  video::ClipAnalysisOptions clip;
+  /// With video_path: verification image (PNG) to write; empty: none.
+  std::filesystem::path verify_path;
+  /// With video_path: progress on stderr, "auto", "live", "lines" or "off" (as `liftoff
+  /// video`).
+  std::string progress = "auto";
+  bool json = false;
+};
+int RunSync(const SyncCommand& command, std::ostream& out, std::ostream& err);
 
 /// The progress of long video analyses on a ProgressLine: frames, video time and rate.
 class VideoProgress {
@@ -91,5 +130,6 @@ TrialVerifications WriteTrialVerifications(const sync::ManifestAnalysis& analysi
 
 /// The command added to the command line `parent` (flags bound to its struct).
 Subcommand AddVideoCommand(Command& parent);
+Subcommand AddSyncCommand(Command& parent);
 
 }  // namespace liftoff::cli
