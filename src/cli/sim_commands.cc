@@ -290,6 +290,7 @@ std::filesystem::path ModelPathFrom(const SimExperimentChoice& choice) {
   return choice.model_path.empty() ? sim::DefaultModelPath() : choice.model_path;
 }
 
+// Long on purpose: the table of the experiment's flags, one line each.
 const std::vector<FieldFlag<sim::ExperimentOptions>>& ExperimentFlags() {
   using O = sim::ExperimentOptions;
   using sim::CableAttachment;

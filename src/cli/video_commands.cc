@@ -2,9 +2,12 @@
 
 #include <unistd.h>
 
+#include <cassert>
 #include <charconv>
+#include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <string>
@@ -116,21 +119,55 @@ std::vector<std::pair<std::string, Foot>> FootWords() {
   return words;
 }
 
-// --rest-window FROM,TO: both ends of the rest window
+// the whole of `text` as a finite number; nullopt otherwise
+std::optional<double> FiniteNumber(std::string_view text) {
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+// --rest-window FROM,TO, s from the LED switch-on: both ends of the rest window (their
+// ranges and order are Validate()'s)
 FieldFlag<ClipOptions> RestWindowFlag() {
-  FieldFlag<ClipOptions> flag = NumbersFlag<ClipOptions>(
-      "--rest-window", "rest_from_led_s", 2,
+  const std::string flag_name = "--rest-window";
+  FieldFlag<ClipOptions> flag = TextFlagOf<ClipOptions>(
+      flag_name, "rest_from_led_s",
       [](const ClipOptions& options) {
-        return std::vector<double>{options.rest_from_led_s, options.rest_to_led_s};
+        return JoinNumbers({options.rest_from_led_s, options.rest_to_led_s}, ",");
       },
-      [](ClipOptions& options, const std::vector<double>& from_to_s) {
-        options.rest_from_led_s = from_to_s[0];
-        options.rest_to_led_s = from_to_s[1];
+      [flag_name](ClipOptions& options, const std::string& text) -> Status {
+        const size_t comma = text.find(',');
+        const std::optional<double> from_s =
+            comma == std::string::npos ? std::nullopt : FiniteNumber(text.substr(0, comma));
+        const std::optional<double> to_s =
+            comma == std::string::npos ? std::nullopt : FiniteNumber(text.substr(comma + 1));
+        if (!from_s || !to_s) {
+          return InvalidArgumentError(
+              flag_name +
+              ": expected FROM,TO in seconds relative to the LED switch-on, FROM < TO, each in "
+              "[-60, 60] (e.g. -0.5,0), got \"" +
+              text + "\"");
+        }
+        options.rest_from_led_s = *from_s;
+        options.rest_to_led_s = *to_s;
+        return Status::Ok();
       },
       "FROM,TO", "Foot rest window FROM,TO in s from the LED switch-on (write --rest-window=-1,0)");
   flag.scaled = true;  // two fields: the message keeps the field's name after the flag's
   flag.more_fields = {"rest_to_led_s"};
   return flag;
+}
+
+// --liftoff's words: the instants' own names
+std::vector<std::pair<std::string, video::LiftoffInstant>> LiftoffWords() {
+  std::vector<std::pair<std::string, video::LiftoffInstant>> words;
+  for (const auto instant : {video::LiftoffInstant::kThreshold, video::LiftoffInstant::kOnset}) {
+    words.emplace_back(std::string(video::LiftoffInstantName(instant)), instant);
+  }
+  return words;
 }
 
 }  // namespace
@@ -164,11 +201,7 @@ const std::vector<FieldFlag<video::ClipAnalysisOptions>>& ClipInstantFlags() {
   using O = ClipOptions;
   static const std::vector<FieldFlag<O>> flags = {
       RestWindowFlag(),
-      ChoiceFlag<O>("--liftoff", LIFTOFF_FIELD(liftoff),
-                    std::vector<std::pair<std::string, video::LiftoffInstant>>{
-                        {"threshold", video::LiftoffInstant::kThreshold},
-                        {"onset", video::LiftoffInstant::kOnset}},
-                    "Liftoff instant"),
+      ChoiceFlag<O>("--liftoff", LIFTOFF_FIELD(liftoff), LiftoffWords(), "Liftoff instant"),
   };
   return flags;
 }
@@ -349,6 +382,7 @@ std::vector<Flag*> AddClipFlags(Command& app, video::ClipAnalysisOptions& clip) 
     if (flag.flag == "--threshold-mm") threshold_mm = added.back();
     if (flag.flag == "--threshold-px") threshold_px = added.back();
   }
+  assert(threshold_mm != nullptr && threshold_px != nullptr && "ClipFlags names both");
   threshold_px->Excludes(threshold_mm);
   return added;
 }

@@ -15,6 +15,7 @@
 
 #include "liftoff/core/json.h"
 #include "liftoff/core/random.h"
+#include "liftoff/core/robust_stats.h"
 #include "liftoff/core/text.h"
 
 namespace liftoff::fit {
@@ -27,15 +28,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 size_t FootIndex(Foot foot) { return static_cast<size_t>(foot); }
 
 double Lerp(double a, double b, double t) { return a + (b - a) * t; }
-
-// the q-quantile of sorted values, linear between order statistics
-double Quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return kNaN;
-  const double position = q * static_cast<double>(sorted.size() - 1);
-  const size_t below = static_cast<size_t>(std::floor(position));
-  const size_t above = std::min(below + 1, sorted.size() - 1);
-  return Lerp(sorted[below], sorted[above], position - static_cast<double>(below));
-}
 
 double StandardDeviation(const std::vector<double>& values) {
   if (values.size() < 2) return 0.0;
@@ -485,8 +477,9 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
   fit.tension = TensionAtSigma(points, best.sigma, "fitted");
   const std::vector<double> sigmas = BootstrapSigmas(targets, curves, errors, options);
   fit.sigma_stddev = StandardDeviation(sigmas);
-  fit.sigma_low95 = Quantile(sigmas, 0.025);
-  fit.sigma_high95 = Quantile(sigmas, 0.975);
+  std::vector<double> quantile_scratch = sigmas;
+  fit.sigma_low95 = FiniteQuantile(quantile_scratch, 0.025);
+  fit.sigma_high95 = FiniteQuantile(quantile_scratch, 0.975);
   fit.sigma_systematic = SystematicSigma(curves, means, errors, targets, best.sigma);
   fit.sigma_total = std::hypot(fit.sigma_stddev, fit.sigma_systematic);
   fit.searched_sigma_min = curves.sigma.front();

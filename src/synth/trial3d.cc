@@ -405,6 +405,8 @@ std::vector<RobotPose3d> ExposurePoses(const Trial3dSpec& spec, const Motion3d& 
   return poses;
 }
 
+// Long on purpose: the truth file's fields, one statement each (docs/synth.md, "Files of
+// one 3D trial", lists them).
 nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
                          const SceneRenderer3d& renderer, const std::vector<int64_t>& pts_ns,
                          const std::vector<cv::Point2d>& shake,
@@ -523,6 +525,62 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
   return truth;
 }
 
+// What RenderAndEncode did: the shake drawn per frame, px, and its time rendering and encoding.
+struct Encoded {
+  std::vector<cv::Point2d> shake;
+  int64_t render_ns = 0;
+  int64_t encode_ns = 0;
+};
+
+// Renders each frame at `pts_ns`, applies the camera's effects, encodes it, then closes
+// `video`.
+Result<Encoded> RenderAndEncode(const Trial3dSpec& spec, const Motion3d& motion,
+                                SceneRenderer3d& renderer, const std::vector<int64_t>& pts_ns,
+                                VideoWriter& video) {
+  Effects effects(spec);
+  FrameCache cache;
+  Encoded encoded;
+  for (size_t i = 0; i < pts_ns.size(); ++i) {
+    const int64_t started_ns = MonotonicNowNs();
+    const double t = SecondsFromNs(pts_ns[i]);
+    const double fraction =
+        spec.led_switches_on ? LedLitFraction(t, spec.exposure_s, spec.led_on_s) : 0.0;
+    const cv::Mat frame =
+        effects.Apply(cache.Get(renderer, ExposurePoses(spec, motion, t), fraction), i, t);
+    encoded.shake.push_back(effects.ShakeAt(i));
+    const int64_t rendered_ns = MonotonicNowNs();
+    LIFTOFF_RETURN_IF_ERROR(video.Write(frame, pts_ns[i]));
+    encoded.render_ns += rendered_ns - started_ns;
+    encoded.encode_ns += MonotonicNowNs() - rendered_ns;
+  }
+  const int64_t closing_ns = MonotonicNowNs();
+  LIFTOFF_RETURN_IF_ERROR(video.Close());
+  encoded.encode_ns += MonotonicNowNs() - closing_ns;
+  return encoded;
+}
+
+// An ok clip's manifest entry: its liftoff-format log, video, regions and scale from `truth`.
+TrialRecord ManifestEntry3d(const Trial3dSpec& spec, const nlohmann::json& truth,
+                            const WrittenTrial3d& written) {
+  TrialRecord entry;
+  entry.id = spec.id;
+  entry.foot = spec.foot;
+  entry.pulled_group = sim::MotionFor(spec.foot).pulled_group;
+  entry.rotation = sim::MotionFor(spec.foot).rotation;
+  entry.log_path = written.liftoff_log_path;
+  entry.log_format = LogFormat::kLiftoff;
+  entry.video_path = written.video_path;
+  const auto region = [](const nlohmann::json& roi) {
+    return RegionPx{roi[0].get<int>(), roi[1].get<int>(), roi[2].get<int>(), roi[3].get<int>()};
+  };
+  entry.led_roi_px = region(truth["led_roi"]);
+  entry.foot_roi_px = region(truth["foot_roi"]);
+  entry.px_per_mm = truth["pixels_per_mm"].get<double>();
+  entry.notes = "synthetic 3D (liftoff synth, seed " + std::to_string(spec.seed) + "); truth in " +
+                spec.id + "/truth.json";
+  return entry;
+}
+
 }  // namespace
 
 TrialSpec LiftoffLogSpec3d(const Trial3dSpec& spec, double duration_s) {
@@ -560,33 +618,14 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
                            VideoWriter::Open(written.video_path, writer_options));
   LIFTOFF_ASSIGN_OR_RETURN(const Timing timing, PlanFrames(spec, motion, *video));
 
-  // render, apply the camera's effects, encode: frame by frame
-  Effects effects(spec);
-  FrameCache cache;
-  std::vector<cv::Point2d> shake;
-  int64_t render_ns = 0, encode_ns = 0;
-  for (size_t i = 0; i < timing.pts_ns.size(); ++i) {
-    const int64_t started_ns = MonotonicNowNs();
-    const double t = SecondsFromNs(timing.pts_ns[i]);
-    const double fraction =
-        spec.led_switches_on ? LedLitFraction(t, spec.exposure_s, spec.led_on_s) : 0.0;
-    const cv::Mat frame =
-        effects.Apply(cache.Get(*renderer, ExposurePoses(spec, motion, t), fraction), i, t);
-    shake.push_back(effects.ShakeAt(i));
-    const int64_t rendered_ns = MonotonicNowNs();
-    LIFTOFF_RETURN_IF_ERROR(video->Write(frame, timing.pts_ns[i]));
-    render_ns += rendered_ns - started_ns;
-    encode_ns += MonotonicNowNs() - rendered_ns;
-  }
-  const int64_t closing_ns = MonotonicNowNs();
-  LIFTOFF_RETURN_IF_ERROR(video->Close());
-  encode_ns += MonotonicNowNs() - closing_ns;
+  LIFTOFF_ASSIGN_OR_RETURN(const Encoded encoded,
+                           RenderAndEncode(spec, motion, *renderer, timing.pts_ns, *video));
 
   // the controller's log and the truth
   const std::vector<ControllerSample> log = ControllerLog3d(spec, timing.duration_s);
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.controller_path, ControllerCsv(log)));
-  const nlohmann::json truth =
-      TruthJson(spec, motion, *renderer, timing.pts_ns, shake, log, video_name, timing.duration_s);
+  const nlohmann::json truth = TruthJson(spec, motion, *renderer, timing.pts_ns, encoded.shake, log,
+                                         video_name, timing.duration_s);
   written.truth_json = truth.dump(1) + "\n";
   written.expect = truth["expect"].get<std::string>();
   const auto seconds = [&](const char* key) -> std::optional<double> {
@@ -602,29 +641,11 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
   LIFTOFF_ASSIGN_OR_RETURN(const Timeline timeline,
                            Timeline::Create(LiftoffLogSpec3d(spec, timing.duration_s)));
   LIFTOFF_RETURN_IF_ERROR(WriteTrialLog(timeline, calibration, written.liftoff_log_path));
-  if (written.expect == "ok") {
-    TrialRecord entry;
-    entry.id = spec.id;
-    entry.foot = spec.foot;
-    entry.pulled_group = sim::MotionFor(spec.foot).pulled_group;
-    entry.rotation = sim::MotionFor(spec.foot).rotation;
-    entry.log_path = written.liftoff_log_path;
-    entry.log_format = LogFormat::kLiftoff;
-    entry.video_path = written.video_path;
-    const auto region = [](const nlohmann::json& roi) {
-      return RegionPx{roi[0].get<int>(), roi[1].get<int>(), roi[2].get<int>(), roi[3].get<int>()};
-    };
-    entry.led_roi_px = region(truth["led_roi"]);
-    entry.foot_roi_px = region(truth["foot_roi"]);
-    entry.px_per_mm = truth["pixels_per_mm"].get<double>();
-    entry.notes = "synthetic 3D (liftoff synth, seed " + std::to_string(spec.seed) +
-                  "); truth in " + spec.id + "/truth.json";
-    written.manifest_entry = std::move(entry);
-  }
+  if (written.expect == "ok") written.manifest_entry = ManifestEntry3d(spec, truth, written);
   LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(written.truth_path, written.truth_json));
   written.frames = static_cast<int64_t>(timing.pts_ns.size());
-  written.render_seconds = SecondsFromNs(render_ns);
-  written.encode_seconds = SecondsFromNs(encode_ns);
+  written.render_seconds = SecondsFromNs(encoded.render_ns);
+  written.encode_seconds = SecondsFromNs(encoded.encode_ns);
   return written;
 }
 

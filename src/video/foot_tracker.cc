@@ -25,14 +25,11 @@
 namespace liftoff::video {
 namespace {
 
-using internal::FiniteMedian;
 using internal::kGroundTolerancePx;
 using internal::MedianCurve;
 using internal::MovingWithTheOthers;
 using internal::RestingWithTheOthers;
 
-using internal::MadSigma;
-using internal::MedianOf;
 using internal::PatchMatch;
 using internal::PatchTemplate;
 using internal::RectText;
@@ -716,6 +713,59 @@ std::vector<size_t> HalfwayHighest(const std::vector<std::pair<double, size_t>>&
   return highest;
 }
 
+// Each patch's median over the rest frames; NaN where it was measured in under half of them.
+std::vector<double> RestLevels(const RiseTable& table, const std::vector<size_t>& rest) {
+  std::vector<double> rest_level(table.patches(), kNaNd);
+  for (size_t p = 0; p < table.patches(); ++p) {
+    std::vector<double> values;
+    for (size_t f : rest) values.push_back(table.Raw(f, p));
+    const double level = FiniteMedian(values);
+    if (values.size() * 2 >= rest.size()) rest_level[p] = level;
+  }
+  return rest_level;
+}
+
+// The foot's candidates among the region's (final rise, patch) pairs `finals`: the rising
+// patches that did not rest with the others before are dropped from `finals`, which is then
+// sorted highest first; the candidates end within kFootFraction of `top`, the second
+// highest final (set here; untouched when no final is left).
+template <typename Relative>
+std::vector<size_t> FootCandidates(std::vector<std::pair<double, size_t>>& finals, size_t first,
+                                   size_t frames, const Relative& relative, double& top) {
+  std::vector<size_t> rising;
+  for (const auto& [final_rise, p] : finals) {
+    if (final_rise > kGroundTolerancePx) rising.push_back(p);
+  }
+  const std::vector<size_t> resting = RestingWithTheOthers(rising, first, frames, relative);
+  std::erase_if(finals, [&](const std::pair<double, size_t>& f) {
+    return f.first > kGroundTolerancePx &&
+           std::find(resting.begin(), resting.end(), f.second) == resting.end();
+  });
+  std::sort(finals.rbegin(), finals.rend());
+  if (finals.empty()) return {};
+  top = finals[std::min<size_t>(1, finals.size() - 1)].first;
+  std::vector<size_t> candidates;
+  for (const auto& [final_rise, p] : finals) {
+    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx) {
+      candidates.push_back(p);
+    }
+  }
+  return candidates;
+}
+
+// Per frame, the share of `patches` measured (0 for none).
+std::vector<double> MeasuredShare(const RiseTable& table, const std::vector<size_t>& patches,
+                                  size_t frames) {
+  std::vector<double> share(frames, 0.0);
+  if (patches.empty()) return share;
+  for (size_t f = 0; f < frames; ++f) {
+    size_t measured = 0;
+    for (size_t p : patches) measured += std::isfinite(table.Raw(f, p)) ? 1u : 0u;
+    share[f] = static_cast<double>(measured) / static_cast<double>(patches.size());
+  }
+  return share;
+}
+
 // Rest levels, the ground (patches that end where they began: their median is the shake),
 // the foot (patches of the region that end highest, less those that do not move with
 // the others) and its height: the median of the foot's patches less the shake.
@@ -724,13 +774,7 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
                              size_t still_until) {
   PatchSelection selection;
   const size_t first = rest.front();
-  std::vector<double> rest_level(table.patches(), kNaNd);
-  for (size_t p = 0; p < table.patches(); ++p) {
-    std::vector<double> values;
-    for (size_t f : rest) values.push_back(table.Raw(f, p));
-    const double level = FiniteMedian(values);
-    if (values.size() * 2 >= rest.size()) rest_level[p] = level;
-  }
+  const std::vector<double> rest_level = RestLevels(table, rest);
   const auto from_rest = [&](size_t f, size_t p) { return table.Raw(f, p) - rest_level[p]; };
   std::vector<size_t> margin, region;
   for (size_t p = 0; p < table.patches(); ++p) {
@@ -759,24 +803,9 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   // the foot: the region's patches that end highest ...
   std::vector<std::pair<double, size_t>> finals = FinalRises(region, first, frames, final_count,
                                                              relative);
-  // (rising patches that did not rest with the others before are no foot)
-  std::vector<size_t> rising;
-  for (const auto& [final_rise, p] : finals) {
-    if (final_rise > kGroundTolerancePx) rising.push_back(p);
-  }
-  const std::vector<size_t> resting = RestingWithTheOthers(rising, first, frames, relative);
-  std::erase_if(finals, [&](const std::pair<double, size_t>& f) {
-    return f.first > kGroundTolerancePx &&
-           std::find(resting.begin(), resting.end(), f.second) == resting.end();
-  });
-  std::sort(finals.rbegin(), finals.rend());
+  double top = 0;
+  const std::vector<size_t> candidates = FootCandidates(finals, first, frames, relative, top);
   if (finals.empty()) return selection;
-  const double top = finals[std::min<size_t>(1, finals.size() - 1)].first;
-  std::vector<size_t> candidates;
-  for (const auto& [final_rise, p] : finals) {
-    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx)
-      candidates.push_back(p);
-  }
   // ... and move with the others, all the way
   selection.foot = MovingWithTheOthers(candidates, first, frames, relative);
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
@@ -793,15 +822,7 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
     selection.lost_rise_px =
         MedianCurve(frames, halfway, std::min<size_t>(2, halfway.size()), relative);
   }
-  selection.quality.assign(frames, 0.0);
-  for (size_t f = 0; f < frames; ++f) {
-    size_t measured = 0;
-    for (size_t p : selection.foot) measured += std::isfinite(table.Raw(f, p)) ? 1u : 0u;
-    if (!selection.foot.empty()) {
-      selection.quality[f] =
-          static_cast<double>(measured) / static_cast<double>(selection.foot.size());
-    }
-  }
+  selection.quality = MeasuredShare(table, selection.foot, frames);
   return selection;
 }
 

@@ -7,8 +7,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "liftoff/core/robust_stats.h"
 #include "liftoff/video/foot_tracker.h"
-#include "robust_stats.h"
 
 namespace liftoff::video::internal {
 

@@ -23,11 +23,8 @@ namespace {
 using internal::ExposureRange;
 using Grid = internal::CellGrid;
 using internal::InstantInterval;
-using internal::kMadToSigma;
 using internal::LitFraction;
 using internal::MeasureCells;
-using internal::MedianOf;
-using internal::OrderQuantileOf;
 using internal::RectText;
 
 // Frames before a step that must be flat.

@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include "robust_stats.h"
+#include "liftoff/core/robust_stats.h"
 
 namespace liftoff::video::internal {
 namespace {

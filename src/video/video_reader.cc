@@ -272,7 +272,7 @@ struct VideoReader::Impl {
     for (const IntervalEntry& entry : window) {
       if (!entry.repaired) read.push_back(entry.interval_ns);
     }
-    return internal::MedianOf(std::move(read));
+    return MedianOf(std::move(read));
   }
 
   void Judge(IntervalEntry& entry, int64_t median_ns) {

@@ -14,7 +14,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
-#include "robust_stats.h"
+#include "liftoff/core/robust_stats.h"
 
 namespace liftoff::video::internal {
 

@@ -157,6 +157,14 @@ TEST(ClipFlags, BindEachFlagToItsField) {
             "--led-roi 563,45,26,27 --foot-roi 300,520,160,120 --foot C --px-per-mm 1.5 "
             "--threshold-px 2.5 --exposure-ms 8");
   EXPECT_EQ(DescribeChanged(ClipInstantFlags(), options), "--rest-window=-1,0.25 --liftoff onset");
+  // --threshold-mm (excluded by --threshold-px above)
+  video::ClipAnalysisOptions in_mm;
+  CLI::App mm_app;
+  Command mm_root(&mm_app);
+  AddClipFlags(mm_root, in_mm);
+  mm_app.parse(std::vector<std::string>{"2.5", "--threshold-mm"});
+  EXPECT_EQ(in_mm.foot.threshold_mm, 2.5);
+  EXPECT_EQ(in_mm.foot.threshold_px, std::nullopt);
 }
 
 // A bad value: the parse or the check names the flag.
@@ -193,7 +201,11 @@ TEST(ClipFlags, ABadValueNamesItsFlag) {
               ::testing::HasSubstr("--rest-window: rest_to_led_s: expected more than"));
   EXPECT_THAT(error({"--rest-window=-70,0"}),
               ::testing::HasSubstr("--rest-window: rest_from_led_s: expected"));
-  EXPECT_THAT(error({"--rest-window=1"}), ::testing::HasSubstr("--rest-window: expected FROM,TO"));
+  for (const char* bad : {"--rest-window=1", "--rest-window=a,0", "--rest-window=1;2",
+                          "--rest-window=0,", "--rest-window=0,1,2", "--rest-window=nan,0"}) {
+    EXPECT_THAT(error({bad}), ::testing::HasSubstr("--rest-window: expected FROM,TO in seconds"))
+        << bad;
+  }
   EXPECT_THAT(error({"--threshold-mm", "1", "--threshold-px", "2"}),
               ::testing::HasSubstr("excludes"));
 }

@@ -457,6 +457,7 @@ TEST(CliVideo, EachErrorHasItsExitCode) {
       {"video " + clip + " --foot-roi 1,2,3", 3, "--foot-roi: expected x,y,w,h"},
       {"video " + clip + " --foot E", 3, "--foot: expected A, B, C or D"},
       {"video " + clip + " --rest-window=0.5,0", 3, "--rest-window"},
+      {"video " + clip + " --rest-window=a,0", 3, "--rest-window: expected FROM,TO"},
       {"video " + clip + " --liftoff knee", 3, "--liftoff: expected threshold or onset"},
       {"video " + clip + " --progress loud", 3, "--progress"},
       {"video " + clip + " --px-per-mm -1", 3, "--px-per-mm"},

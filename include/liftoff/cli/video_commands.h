@@ -1,9 +1,9 @@
 // `liftoff video`: one clip's LED switch-on and foot liftoff, with proof (verification
-// image, annotated video); and the video parts of `liftoff table` (progress while trials'
-// videos are analysed, a verification image per analysed trial). Same shape as
-// commands.h: an Add function binds flags to each struct; each Run function
-// writes results to `out`, progress and diagnostics to `err`, and returns the process
-// exit code (ExitCodeFor; docs/cli.md).
+// image, annotated video); `liftoff sync` (its instants from the command line or a clip's
+// analysis, with the same clip flags); and the video parts of `liftoff table` (progress while
+// trials' videos are analysed, a verification image per analysed trial). Same shape as commands.h:
+// an Add function binds flags to each struct; each Run function writes results to `out`, progress
+// and diagnostics to `err`, and returns the process exit code (ExitCodeFor; docs/cli.md).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
-// The video module's robust statistics (src/video/robust_stats.h, through video_util.h)
-// against sorting, on seeded random samples of odd and even sizes, against analytic cases,
-// and on the cases that take a branch of their own.
-#include "video_util.h"
+// The robust statistics (liftoff/core/robust_stats.h) against sorting, on seeded random
+// samples of odd and even sizes, against analytic cases, and on the cases that take a
+// branch of their own.
+#include "liftoff/core/robust_stats.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-namespace liftoff::video::internal {
+namespace liftoff {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -114,4 +114,4 @@ TEST(MadSigma, TheMedianAbsoluteDeviationScaledToAGaussiansSigma) {
 }
 
 }  // namespace
-}  // namespace liftoff::video::internal
+}  // namespace liftoff

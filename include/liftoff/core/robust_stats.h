@@ -1,6 +1,6 @@
-// Robust statistics the video module's detectors share (private: not installed, not for
-// other modules; no OpenCV): medians, quantiles and the median-absolute-deviation scale.
-// Each is tested in tests/video/video_util_test.cc against sorting or an analytic case.
+// Robust statistics the detectors and fits share (header-only, no OpenCV): medians,
+// quantiles and the median-absolute-deviation scale. Each is tested in
+// tests/core/robust_stats_test.cc against sorting or an analytic case.
 #pragma once
 
 #include <algorithm>
@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-namespace liftoff::video::internal {
+namespace liftoff {
 
 /// A Gaussian's standard deviation per median absolute deviation (1 / 0.6745).
 inline constexpr double kMadToSigma = 1.4826;
@@ -78,7 +78,7 @@ inline double FiniteQuantile(std::vector<double>& values, double q) {
   KeepFinite(values);
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(values.begin(), values.end());
-  const double at = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const double at = q * static_cast<double>(values.size() - 1);
   const auto below = static_cast<size_t>(std::floor(at));
   const size_t above = std::min(values.size() - 1, below + 1);
   return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
@@ -104,4 +104,4 @@ inline double SuccessiveDifferenceSigma(const std::vector<double>& series) {
   return kMadToSigma * MedianOf(std::move(changes)) / std::sqrt(2.0);
 }
 
-}  // namespace liftoff::video::internal
+}  // namespace liftoff
