@@ -100,8 +100,15 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     if (!command.quiet) err << "[" << index + 1 << "/" << count << "] " << id << '\n';
   };
   if (command.set_name != "campaign") {
+    synth::Set3dVariation variation;
+    variation.seed_offset = command.seed_offset;
+    variation.rise_slowdown = command.rise_slowdown;
+    if (auto named = MessageNamingFlag(variation.Validate().message(), "--rise-slowdown",
+                                       "rise_slowdown", false)) {
+      return InvalidArgumentError(*named);
+    }
     return synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress,
-                             command.seed_offset);
+                             variation);
   }
   return synth::WriteCampaign(CampaignOptionsFrom(command), calibration, command.output_dir,
                              progress);
@@ -166,6 +173,10 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
+  if (command.set_name == "campaign" && command.rise_slowdown != 1.0) {
+    err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
+    return kExitUsage;
+  }
   if (command.set_name == "ci3d" || command.set_name == "hard3d" ||
       command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);
@@ -173,6 +184,10 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   if (command.seed_offset != 0) {
     err << "liftoff synth: --seed works with --set ci3d, hard3d or campaign (a spec has its "
            "own seed)\n";
+    return kExitUsage;
+  }
+  if (command.rise_slowdown != 1.0) {
+    err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)
@@ -193,6 +208,10 @@ Subcommand AddSynthCommand(Command& parent) {
   app->AddOption("--seed", command->seed_offset,
                   "--set ci3d, hard3d or campaign: every clip's seeds offset by this (0: the "
                   "set as documented; another: its conditions drawn anew)")
+      ->ShowDefault();
+  app->AddOption("--rise-slowdown", command->rise_slowdown,
+                 "--set ci3d or hard3d: every foot rises this many times slower than simulated "
+                 "once off the ground (1 .. 20)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

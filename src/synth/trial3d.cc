@@ -216,6 +216,8 @@ Status Trial3dSpec::Validate() const {
     return OutOfRange(id, "max_rotation_rad", max_rotation_rad, 0.05, kPi / 3);
   if (!(contact_floor_m >= 0 && contact_floor_m <= 1e-3))
     return OutOfRange(id, "contact_floor_m", contact_floor_m, 0, 1e-3);
+  if (!(rise_slowdown >= 1 && rise_slowdown <= 20))
+    return OutOfRange(id, "rise_slowdown", rise_slowdown, 1, 20);
   if (!(fps >= 1 && fps <= 240)) return OutOfRange(id, "fps", fps, 1, 240);
   if (!(exposure_s > 0 && exposure_s <= 1 / fps))
     return OutOfRange(id, "exposure_s", exposure_s, 0, 1 / fps);
@@ -258,6 +260,26 @@ double Motion3d::VertebraRadAt(double t_video_s) const {
   return Interpolate(time_s, vertebra_rad, t_video_s);
 }
 
+namespace {
+
+// After motion.t_lift_s, each height is the simulated one `slowdown` times nearer the lift
+// (the simulated curve's linear interpolation), the vertebra as it was.
+void SlowTheRise(double slowdown, Motion3d& motion) {
+  const double lift_s = *motion.t_lift_s;
+  const std::vector<double> simulated_m = motion.height_m;
+  for (size_t i = 0; i < motion.time_s.size(); ++i) {
+    if (motion.time_s[i] <= lift_s) continue;
+    const double t_s = lift_s + (motion.time_s[i] - lift_s) / slowdown;
+    const auto after = std::upper_bound(motion.time_s.begin(), motion.time_s.end(), t_s);
+    const size_t b = static_cast<size_t>(after - motion.time_s.begin());
+    const size_t a = b - 1;  // time_s[0] = 0 <= lift_s < t_s
+    const double w = (t_s - motion.time_s[a]) / (motion.time_s[b] - motion.time_s[a]);
+    motion.height_m[i] = simulated_m[a] + w * (simulated_m[b] - simulated_m[a]);
+  }
+}
+
+}  // namespace
+
 Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec) {
   LIFTOFF_RETURN_IF_ERROR(spec.Validate());
   LIFTOFF_ASSIGN_OR_RETURN(sim::ModelDescription description,
@@ -293,6 +315,7 @@ Result<Motion3d> SimulateMotion3d(const Trial3dSpec& spec) {
     motion.height_m.push_back(h < spec.contact_floor_m ? 0.0 : h);
   }
   motion.t_lift_s = FirstAbove(motion.time_s, motion.height_m, 0.0);
+  if (motion.t_lift_s && spec.rise_slowdown != 1.0) SlowTheRise(spec.rise_slowdown, motion);
   motion.t_lift_1mm_s = FirstAbove(motion.time_s, motion.height_m, 0.001);
   if (run.feet[foot].lifted) motion.sim_liftoff_rad = run.feet[foot].rotation_rad;
   motion.sim_brief = run.Brief();
@@ -503,25 +526,38 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
   truth["sim_liftoff_rad"] = motion.sim_liftoff_rad ? json(*motion.sim_liftoff_rad) : json(nullptr);
   const Scene3dOptions& scene = spec.scene;
   truth["params"] = {
-      {"seed", spec.seed}, {"view", std::string(CameraViewName(scene.view))},
-      {"camera_height_m", scene.camera_height_m}, {"camera_distance_m", scene.camera_distance_m},
-      {"fovy_deg", scene.fovy_deg}, {"foot_shape", std::string(FootShapeName(scene.foot_shape))},
+      {"seed", spec.seed},
+      {"view", std::string(CameraViewName(scene.view))},
+      {"camera_height_m", scene.camera_height_m},
+      {"camera_distance_m", scene.camera_distance_m},
+      {"fovy_deg", scene.fovy_deg},
+      {"foot_shape", std::string(FootShapeName(scene.foot_shape))},
       {"colouring", static_cast<int>(scene.colouring)},
       {"floor", scene.floor == FloorKind::kGlossy ? "glossy" : "textured"},
       {"floor_reflectance", scene.floor == FloorKind::kGlossy ? scene.floor_reflectance : 0.0},
-      {"clutter_count", scene.clutter_count}, {"light_elevation_deg", scene.light_elevation_deg},
-      {"light_azimuth_deg", scene.light_azimuth_deg}, {"light_level", scene.light_level},
-      {"led_radius_m", scene.led_radius_m}, {"tension_point_index", spec.tension_point_index},
-      {"tension_point", spec.tension ? spec.tension->name
-                                     : sim::PaperTensionPoints()[static_cast<size_t>(
-                                           spec.tension_point_index)].name},
-      {"max_rotation_rad", spec.max_rotation_rad}, {"drop_probability", spec.drop_probability},
+      {"clutter_count", scene.clutter_count},
+      {"light_elevation_deg", scene.light_elevation_deg},
+      {"light_azimuth_deg", scene.light_azimuth_deg},
+      {"light_level", scene.light_level},
+      {"led_radius_m", scene.led_radius_m},
+      {"tension_point_index", spec.tension_point_index},
+      {"tension_point",
+       spec.tension
+           ? spec.tension->name
+           : sim::PaperTensionPoints()[static_cast<size_t>(spec.tension_point_index)].name},
+      {"max_rotation_rad", spec.max_rotation_rad},
+      {"drop_probability", spec.drop_probability},
       {"timestamp_jitter_s", spec.timestamp_jitter_s},
-      {"drop_frames_at_led", spec.drop_frames_at_led}, {"quality", spec.quality},
-      {"noise_sigma", spec.noise_sigma}, {"gain", spec.gain},
-      {"flicker_amplitude", spec.flicker_amplitude}, {"flicker_hz", spec.flicker_hz},
-      {"shake_px", spec.shake_px}, {"blur_sigma_px", spec.blur_sigma_px},
-      {"motion_blur_samples", spec.motion_blur_samples}};
+      {"drop_frames_at_led", spec.drop_frames_at_led},
+      {"quality", spec.quality},
+      {"noise_sigma", spec.noise_sigma},
+      {"gain", spec.gain},
+      {"flicker_amplitude", spec.flicker_amplitude},
+      {"flicker_hz", spec.flicker_hz},
+      {"shake_px", spec.shake_px},
+      {"blur_sigma_px", spec.blur_sigma_px},
+      {"motion_blur_samples", spec.motion_blur_samples},
+      {"rise_slowdown", spec.rise_slowdown}};
   return truth;
 }
 
@@ -915,17 +951,33 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
   return summary;
 }
 
+Status Set3dVariation::Validate() const {
+  if (!(rise_slowdown >= 1 && rise_slowdown <= 20)) {
+    return InvalidArgumentError("rise_slowdown: expected 1 .. 20, got " +
+                                FormatNumber(rise_slowdown));
+  }
+  return Status::Ok();
+}
+
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
                                 const Calibration& calibration, const Set3dProgress& progress,
-                                uint64_t seed_offset) {
+                                const Set3dVariation& variation) {
+  LIFTOFF_RETURN_IF_ERROR(variation.Validate());
   LIFTOFF_ASSIGN_OR_RETURN(std::vector<Trial3dSpec> set, Set3dNamed(name));
   for (Trial3dSpec& spec : set) {
-    spec.seed += seed_offset;
-    spec.scene.seed += seed_offset;
+    spec.seed += variation.seed_offset;
+    spec.scene.seed += variation.seed_offset;
+    spec.rise_slowdown = variation.rise_slowdown;
+  }
+  std::string varied;
+  if (variation.seed_offset != 0) {
+    varied += ", seeds offset by " + std::to_string(variation.seed_offset);
+  }
+  if (variation.rise_slowdown != 1.0) {
+    varied += ", the feet rising " + FormatNumber(variation.rise_slowdown) + " times slower";
   }
   const std::string description =
-      seed_offset == 0 ? "" : "liftoff synth set " + name + " (" + calibration.name +
-                                  "), seeds offset by " + std::to_string(seed_offset);
+      varied.empty() ? "" : "liftoff synth set " + name + " (" + calibration.name + ")" + varied;
   return WriteSpecs3d(name, set, output_dir, calibration, description, progress);
 }
 

@@ -350,6 +350,35 @@ TEST(Trial3d, LiftInstantAgreesWithTheSimulationsOwnLiftoff) {
   }
 }
 
+// rise_slowdown: the same ground contact, the lift stretched in time after it (each height
+// the simulated one that many times nearer the lift), the vertebra turning as before.
+TEST(Trial3d, ASlowerRiseStretchesTheLiftAfterTheGroundContact) {
+  Trial3dSpec spec = ShortSpec();
+  auto simulated = SimulateMotion3d(spec);
+  spec.rise_slowdown = 3.0;
+  auto slowed = SimulateMotion3d(spec);
+  ASSERT_TRUE(simulated.ok() && slowed.ok()) << slowed.status().ToString();
+  ASSERT_TRUE(simulated->t_lift_s && simulated->t_lift_1mm_s && slowed->t_lift_1mm_s);
+  const double lift_s = *simulated->t_lift_s;
+  EXPECT_EQ(*slowed->t_lift_s, lift_s);
+  // the 1 mm instant three times as far from the lift (within the 0.01 s samples' reach)
+  EXPECT_NEAR(*slowed->t_lift_1mm_s - lift_s, 3.0 * (*simulated->t_lift_1mm_s - lift_s), 0.02);
+  for (double t_s = 0.5; t_s < lift_s; t_s += 0.5) {
+    EXPECT_EQ(slowed->HeightMAt(t_s), simulated->HeightMAt(t_s)) << t_s;
+  }
+  for (double after_s : {0.05, 0.2, 0.4}) {
+    EXPECT_NEAR(slowed->HeightMAt(lift_s + 3.0 * after_s), simulated->HeightMAt(lift_s + after_s),
+                2e-4)
+        << after_s;
+  }
+  EXPECT_EQ(slowed->VertebraRadAt(lift_s + 0.3), simulated->VertebraRadAt(lift_s + 0.3));
+  spec.rise_slowdown = 0.5;
+  EXPECT_NE(spec.Validate().message().find("rise_slowdown"), std::string::npos);
+  Set3dVariation variation;
+  variation.rise_slowdown = 21;
+  EXPECT_NE(variation.Validate().message().find("rise_slowdown"), std::string::npos);
+}
+
 TEST(Trial3d, LedFractionOfTheCentredExposure) {
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 1.0), 0.5, 1e-12);
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 0.995), 0.75, 1e-12);

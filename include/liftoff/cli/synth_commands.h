@@ -25,6 +25,9 @@ struct SynthCommand {
   /// --set campaign: trials per foot (CampaignOptions::trials_per_foot).
   int campaign_trials_per_foot = 5;
   uint64_t seed_offset = 0;  ///< --seed: the 3D sets' seeds offset by it
+  /// --rise-slowdown: ci3d and hard3d's feet rising this many times slower (1 .. 20;
+  /// synth::Set3dVariation).
+  double rise_slowdown = 1.0;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.
