@@ -531,6 +531,25 @@ std::string SetSummary::Brief() const {
   return text;
 }
 
+namespace {
+
+// Support files: the CSV height curve the CI set's csv trial reads, written once into
+// `output_dir` when a spec reads it, and those specs pointed at it.
+Status WriteSupportFiles(const fs::path& output_dir, std::vector<TrialSpec>& specs) {
+  bool curve_written = false;
+  for (TrialSpec& spec : specs) {
+    if (spec.motion.height.kind != "csv" || spec.motion.height.csv_path != kCiCurveFile) continue;
+    if (!curve_written) {
+      LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(output_dir / kCiCurveFile, CiHeightCurveCsv()));
+      curve_written = true;
+    }
+    spec.motion.height.csv_path = output_dir / kCiCurveFile;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Result<SetSummary> WriteSet(std::string_view name, const Calibration& calibration,
                             const fs::path& output_dir,
                             const std::function<void(const SetProgress&)>& progress) {
@@ -542,16 +561,7 @@ Result<SetSummary> WriteSet(std::string_view name, const Calibration& calibratio
   fs::create_directories(output_dir, error);
   if (error) return IoError(output_dir.string() + ": cannot create the folder: " + error.message());
 
-  // support files: the CSV height curve the CI set's csv trial reads
-  bool curve_written = false;
-  for (TrialSpec& spec : specs) {
-    if (spec.motion.height.kind != "csv" || spec.motion.height.csv_path != kCiCurveFile) continue;
-    if (!curve_written) {
-      LIFTOFF_RETURN_IF_ERROR(WriteFileAtomically(output_dir / kCiCurveFile, CiHeightCurveCsv()));
-      curve_written = true;
-    }
-    spec.motion.height.csv_path = output_dir / kCiCurveFile;
-  }
+  LIFTOFF_RETURN_IF_ERROR(WriteSupportFiles(output_dir, specs));
 
   // every item on up to two workers; each item's files depend on nothing but the item
   const size_t count = specs.size() + invalid.size();
