@@ -173,7 +173,7 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
-  if (command.set_name == "campaign" && command.rise_slowdown != 1.0) {
+  if (command.rise_slowdown != 1.0 && command.set_name != "ci3d" && command.set_name != "hard3d") {
     err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
@@ -184,10 +184,6 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   if (command.seed_offset != 0) {
     err << "liftoff synth: --seed works with --set ci3d, hard3d or campaign (a spec has its "
            "own seed)\n";
-    return kExitUsage;
-  }
-  if (command.rise_slowdown != 1.0) {
-    err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
   return command.set_name.empty() ? RunOneTrial(command, *calibration, out, err)

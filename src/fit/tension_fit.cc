@@ -475,11 +475,10 @@ Result<TensionFit> FitTension(const std::vector<FootTarget>& targets,
   fit.sigma = best.sigma;
   fit.chi_square = best.chi_square;
   fit.tension = TensionAtSigma(points, best.sigma, "fitted");
-  const std::vector<double> sigmas = BootstrapSigmas(targets, curves, errors, options);
+  std::vector<double> sigmas = BootstrapSigmas(targets, curves, errors, options);
   fit.sigma_stddev = StandardDeviation(sigmas);
-  std::vector<double> quantile_scratch = sigmas;
-  fit.sigma_low95 = FiniteQuantile(quantile_scratch, 0.025);
-  fit.sigma_high95 = FiniteQuantile(quantile_scratch, 0.975);
+  fit.sigma_low95 = FiniteQuantile(sigmas, 0.025);
+  fit.sigma_high95 = FiniteQuantile(sigmas, 0.975);
   fit.sigma_systematic = SystematicSigma(curves, means, errors, targets, best.sigma);
   fit.sigma_total = std::hypot(fit.sigma_stddev, fit.sigma_systematic);
   fit.searched_sigma_min = curves.sigma.front();

@@ -26,6 +26,13 @@ constexpr uint64_t kShakeStream = 0x5A4E3D0000000001ull;
 constexpr uint64_t kNoiseStream = 0x5A4E3D0000000002ull;
 constexpr uint64_t kLogStream = 0x5A4E3D0000000003ull;
 
+// Trial3dSpec::rise_slowdown's range (Set3dVariation's too).
+Status CheckRiseSlowdown(double rise_slowdown) {
+  if (rise_slowdown >= 1 && rise_slowdown <= 20) return Status::Ok();
+  return InvalidArgumentError("rise_slowdown: expected 1 .. 20, got " +
+                              FormatNumber(rise_slowdown));
+}
+
 Status OutOfRange(const std::string& id, const char* field, double value, double low, double high) {
   std::ostringstream message;
   message << "trial3d " << id << ": " << field << ": expected a number in [" << low << ", "
@@ -216,8 +223,7 @@ Status Trial3dSpec::Validate() const {
     return OutOfRange(id, "max_rotation_rad", max_rotation_rad, 0.05, kPi / 3);
   if (!(contact_floor_m >= 0 && contact_floor_m <= 1e-3))
     return OutOfRange(id, "contact_floor_m", contact_floor_m, 0, 1e-3);
-  if (!(rise_slowdown >= 1 && rise_slowdown <= 20))
-    return OutOfRange(id, "rise_slowdown", rise_slowdown, 1, 20);
+  LIFTOFF_RETURN_IF_ERROR(CheckRiseSlowdown(rise_slowdown).WithContext("trial3d " + id));
   if (!(fps >= 1 && fps <= 240)) return OutOfRange(id, "fps", fps, 1, 240);
   if (!(exposure_s > 0 && exposure_s <= 1 / fps))
     return OutOfRange(id, "exposure_s", exposure_s, 0, 1 / fps);
@@ -951,13 +957,7 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
   return summary;
 }
 
-Status Set3dVariation::Validate() const {
-  if (!(rise_slowdown >= 1 && rise_slowdown <= 20)) {
-    return InvalidArgumentError("rise_slowdown: expected 1 .. 20, got " +
-                                FormatNumber(rise_slowdown));
-  }
-  return Status::Ok();
-}
+Status Set3dVariation::Validate() const { return CheckRiseSlowdown(rise_slowdown); }
 
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
                                 const Calibration& calibration, const Set3dProgress& progress,

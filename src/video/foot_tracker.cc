@@ -725,13 +725,19 @@ std::vector<double> RestLevels(const RiseTable& table, const std::vector<size_t>
   return rest_level;
 }
 
+// The foot's candidates: patches, and the level they are judged against, px.
+struct FootCandidates {
+  std::vector<size_t> patches;
+  double top_px = 0.0;
+};
+
 // The foot's candidates among the region's (final rise, patch) pairs `finals`: the rising
 // patches that did not rest with the others before are dropped from `finals`, which is then
-// sorted highest first; the candidates end within kFootFraction of `top`, the second
-// highest final (set here; untouched when no final is left).
+// sorted highest first; the candidates end within kFootFraction of the second highest final
+// (none when no final is left).
 template <typename Relative>
-std::vector<size_t> FootCandidates(std::vector<std::pair<double, size_t>>& finals, size_t first,
-                                   size_t frames, const Relative& relative, double& top) {
+FootCandidates ChooseFootCandidates(std::vector<std::pair<double, size_t>>& finals, size_t first,
+                                    size_t frames, const Relative& relative) {
   std::vector<size_t> rising;
   for (const auto& [final_rise, p] : finals) {
     if (final_rise > kGroundTolerancePx) rising.push_back(p);
@@ -742,12 +748,12 @@ std::vector<size_t> FootCandidates(std::vector<std::pair<double, size_t>>& final
            std::find(resting.begin(), resting.end(), f.second) == resting.end();
   });
   std::sort(finals.rbegin(), finals.rend());
-  if (finals.empty()) return {};
-  top = finals[std::min<size_t>(1, finals.size() - 1)].first;
-  std::vector<size_t> candidates;
+  FootCandidates candidates;
+  if (finals.empty()) return candidates;
+  candidates.top_px = finals[std::min<size_t>(1, finals.size() - 1)].first;
   for (const auto& [final_rise, p] : finals) {
-    if (final_rise >= kFootFraction * top && final_rise > kGroundTolerancePx) {
-      candidates.push_back(p);
+    if (final_rise >= kFootFraction * candidates.top_px && final_rise > kGroundTolerancePx) {
+      candidates.patches.push_back(p);
     }
   }
   return candidates;
@@ -803,18 +809,18 @@ PatchSelection SelectPatches(const RiseTable& table, const std::vector<TrackedPa
   // the foot: the region's patches that end highest ...
   std::vector<std::pair<double, size_t>> finals = FinalRises(region, first, frames, final_count,
                                                              relative);
-  double top = 0;
-  const std::vector<size_t> candidates = FootCandidates(finals, first, frames, relative, top);
+  const FootCandidates candidates = ChooseFootCandidates(finals, first, frames, relative);
   if (finals.empty()) return selection;
   // ... and move with the others, all the way
-  selection.foot = MovingWithTheOthers(candidates, first, frames, relative);
+  selection.foot = MovingWithTheOthers(candidates.patches, first, frames, relative);
   const size_t needed = std::max<size_t>(1, (selection.foot.size() * 3 + 9) / 10);
   selection.height_px = MedianCurve(frames, selection.foot, needed, relative);
   for (size_t p : selection.foot) {
     std::vector<double>& curve = selection.foot_curves_px.emplace_back(frames);
     for (size_t f = 0; f < frames; ++f) curve[f] = relative(f, p);
   }
-  std::vector<size_t> halfway = HalfwayHighest(finals, first, frames, final_count, top, relative);
+  std::vector<size_t> halfway =
+      HalfwayHighest(finals, first, frames, final_count, candidates.top_px, relative);
   std::erase_if(halfway, [&](size_t p) {
     return std::find(selection.foot.begin(), selection.foot.end(), p) != selection.foot.end();
   });
