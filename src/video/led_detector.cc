@@ -148,6 +148,9 @@ constexpr size_t kContrastRank = 2;
 constexpr double kStrongerFactor = 3.0;
 // Intervals kept for the usual frame interval (the bound of an unknown exposure).
 constexpr size_t kIntervalWindow = 31;
+// With an ROI, a build-up: the LED's pixels leave their old level and reach the new one over
+// at most this many frames (a codec holding a small spot at a partial level, or wobbling).
+constexpr int kBuildUpFrames = 12;
 // Recorded steps per region at most (a region that keeps stepping is no sync LED).
 constexpr size_t kMaxEventsPerRegion = 4096;
 
@@ -166,26 +169,27 @@ std::vector<uint8_t> InnerMask(int width_px, int height_px) {
 // Every how many of `count` values a quantile looks at (about kQuantileSamples of them).
 size_t SampleStride(size_t count) { return std::max<size_t>(1, count / kQuantileSamples); }
 
-// The shape of a window of a series around a step at its frame `before_count`: the
-// levels before and after (medians), the step between them (positive in the step's
-// direction), the spread of the frames before (the last one left out when it is already
-// up to threshold_frac of the way: a codec's B-frame borrows light from the next frame),
-// how far the frames after fall back against the step, and how far they go on in its
-// direction (a codec refines a small bright spot over a few frames).
+// The shape of a window of a series around a step at its frame `before_count` (or a
+// build-up over the `gap` frames from there; 1 for a step): the levels before and after (medians),
+// the step between them (positive in the step's direction), the spread of the frames before (the
+// last one left out when it is already up to threshold_frac of the way: a codec's B-frame borrows
+// light from the next frame), how far the frames after fall back against the step, and how far they
+// go on in its direction (a codec refines a small bright spot over a few frames).
 struct WindowShape {
   double before_level = 0.0, after_level = 0.0, step = 0.0;
   double before_spread = 0.0, after_against = 0.0, after_creep = 0.0;
 };
 
-WindowShape ShapeOf(const double* values, int before_count, int after_count, bool rise,
+WindowShape ShapeOf(const double* values, int before_count, int gap, int after_count, bool rise,
                     double threshold_frac, std::vector<double>& scratch) {
   const double sign = rise ? 1.0 : -1.0;
   const auto before = static_cast<size_t>(before_count);
+  const auto after_first = before + static_cast<size_t>(gap);
   const auto after = static_cast<size_t>(after_count);
   WindowShape shape;
-  scratch.assign(values, values + before + 1 + after);
+  scratch.assign(values, values + after_first + after);
   shape.before_level = MedianOf(scratch.data(), before_count);
-  shape.after_level = MedianOf(scratch.data() + before + 1, after_count);
+  shape.after_level = MedianOf(scratch.data() + after_first, after_count);
   shape.step = sign * (shape.after_level - shape.before_level);
   size_t flat_before = before;
   if (before >= 3) {
@@ -198,7 +202,7 @@ WindowShape ShapeOf(const double* values, int before_count, int after_count, boo
   shape.before_spread = *high - *low;
   double furthest = -std::numeric_limits<double>::infinity();
   double least = std::numeric_limits<double>::infinity();
-  for (size_t i = before + 1; i < before + 1 + after; ++i) {
+  for (size_t i = after_first; i < after_first + after; ++i) {
     const double along = sign * values[i];
     furthest = std::max(furthest, along);
     shape.after_against = std::max(shape.after_against, furthest - along);
@@ -303,8 +307,11 @@ struct LedDetector::Impl {
   double pixels_per_region = 0.0;  // pixels summed per region (sampled rows)
 
   // the last `ring` frames: times, flicker gains, the cells' flicker-corrected sums and
-  // brightest channels, the regions' sums (and the ROI's brightest channel)
+  // brightest channels, the regions' sums (and the ROI's brightest channel). A step is
+  // judged on a `window` of them (kBeforeFrames, the step, after_frames); with an ROI the
+  // ring is longer, for a build-up (kBuildUpFrames)
   int after_frames = 3;
+  int window = 0;
   int ring = 0;
   int64_t frames = 0;
   std::vector<int64_t> ring_index, ring_t_ns;
@@ -420,10 +427,11 @@ struct LedDetector::Impl {
   // that clip when lit unless they carry most of the step (then the event is marked
   // clipped). False when the step does not look like a light: pixels stepping the other
   // way by a good part of it (an edge moved by camera shake or a passing part).
-  bool MeasureRoiStep(int64_t k, bool rise, StepEvent& event);
+  // A build-up: the `gap` frames from k on (1 for a step) lie between the levels.
+  bool MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent& event);
   // Each ROI pixel's step at frame k (pixel_steps, channel_steps, lit_peaks, pixel_wobble;
   // its gain-corrected series in `corrected`); the sums of the pixels' off and on levels.
-  void MeasurePixelSteps(int64_t k, bool rise, double& off_sum, double& on_sum);
+  void MeasurePixelSteps(int64_t k, int gap, bool rise, double& off_sum, double& on_sum);
   // the quantile q of |pixel_steps| over the ROI's inner pixels
   double InnerQuantile(double q);
 
@@ -444,7 +452,7 @@ struct LedDetector::Impl {
   // signed so that the step's direction is positive
   template <typename T>
   double WindowStep(const std::vector<T>& series, size_t stride, size_t offset, int64_t k,
-                    bool rise, std::vector<T>& window) const;
+                    bool rise, std::vector<T>& scratch) const;
 
   // located: the LED's own contrast, grey levels: the step of the brightest channel of the
   // block's best cell, or of its mean where that is larger (a brighter object beside the
@@ -508,7 +516,8 @@ Status LedDetector::Impl::Setup(const Frame& frame) {
   width_px = frame.bgr.cols;
   height_px = frame.bgr.rows;
   after_frames = options.min_on_frames;
-  ring = kBeforeFrames + 1 + after_frames;
+  window = kBeforeFrames + 1 + after_frames;
+  ring = located ? window : kBeforeFrames + kBuildUpFrames + after_frames;
   if (width_px < 2 * options.cell_px || height_px < 2 * options.cell_px) {
     return InvalidArgumentError("frame " + std::to_string(width_px) + "x" +
                                 std::to_string(height_px) + " is smaller than 2 x 2 cells of " +
@@ -715,8 +724,11 @@ double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gai
   const cv::Rect& roi = options.roi_px;
   uint8_t* picture = RoiPicture(slot);
   float* strip = StripSamples(slot);
-  // the frame leaving the ring joins the references (the first frame starts them)
-  if (frames >= ring) FollowReference(picture, strip);
+  // the frame leaving the window joins the references (the first frame starts them)
+  if (frames >= window) {
+    const size_t leaving = Slot(frames - window);
+    FollowReference(RoiPicture(leaving), StripSamples(leaving));
+  }
   const auto row_bytes = static_cast<size_t>(roi.width) * 3;
   for (int y = 0; y < roi.height; ++y) {
     std::memcpy(picture + static_cast<size_t>(y) * row_bytes,
@@ -771,29 +783,32 @@ bool LedDetector::Impl::SmallLightInRenewedBlock(double largest, size_t width) c
          opposite_strong <= kRoiOppositeFrac * stepped_strong;
 }
 
-void LedDetector::Impl::MeasurePixelSteps(int64_t k, bool rise, double& off_sum, double& on_sum) {
+void LedDetector::Impl::MeasurePixelSteps(int64_t k, int gap, bool rise, double& off_sum,
+                                          double& on_sum) {
   const size_t pixels = pixel_reference.size();
   const auto frames_in_ring = static_cast<size_t>(ring);
   const auto before = static_cast<size_t>(kBeforeFrames);
+  const size_t after_first = before + static_cast<size_t>(gap);
+  const size_t count = after_first + static_cast<size_t>(after_frames);
   const auto width = static_cast<size_t>(options.roi_px.width);
-  std::vector<float> peaks(frames_in_ring);
+  std::vector<float> peaks(count);
   off_sum = on_sum = 0.0;
   for (size_t i = 0; i < pixels; ++i) {
     float* values = &corrected[i * frames_in_ring];
-    for (size_t j = 0; j < frames_in_ring; ++j) {
+    for (size_t j = 0; j < count; ++j) {
       const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
       const uint8_t* pixel = RoiPicture(slot) + 3 * i;
       values[j] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) -
                   (RowGains(slot)[i / width] - 1.0f) * pixel_reference[i];
       peaks[j] = static_cast<float>(std::max({pixel[0], pixel[1], pixel[2]}));
     }
-    std::copy(values, values + frames_in_ring, window_sums.begin());
+    std::copy(values, values + count, window_sums.begin());
     const double level_before = MedianOf(window_sums.data(), kBeforeFrames);
     const double level_after =
-        MedianOf(window_sums.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+        MedianOf(window_sums.data() + after_first, static_cast<std::ptrdiff_t>(after_frames));
     const double peak_before = MedianOf(peaks.data(), kBeforeFrames);
     const double peak_after =
-        MedianOf(peaks.data() + before + 1, static_cast<std::ptrdiff_t>(after_frames));
+        MedianOf(peaks.data() + after_first, static_cast<std::ptrdiff_t>(after_frames));
     pixel_steps[i] = rise ? level_after - level_before : level_before - level_after;
     channel_steps[i] = rise ? peak_after - peak_before : peak_before - peak_after;
     lit_peaks[i] = rise ? peak_after : peak_before;
@@ -804,12 +819,13 @@ void LedDetector::Impl::MeasurePixelSteps(int64_t k, bool rise, double& off_sum,
   }
 }
 
-bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
+bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent& event) {
   const size_t pixels = pixel_reference.size();
   const auto frames_in_ring = static_cast<size_t>(ring);
+  const auto count = static_cast<size_t>(kBeforeFrames + gap + after_frames);
   const auto width = static_cast<size_t>(options.roi_px.width);
   double off_sum = 0.0, on_sum = 0.0;
-  MeasurePixelSteps(k, rise, off_sum, on_sum);
+  MeasurePixelSteps(k, gap, rise, off_sum, on_sum);
   // a pixel's noise (the median frame-to-frame change is sqrt(2) / kMadToSigma = 0.954
   // sigma for Gaussian noise)
   const double sigma = MedianOf(pixel_wobble.data(), static_cast<std::ptrdiff_t>(pixels)) *
@@ -839,14 +855,14 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
     contrasts.push_back(channel_steps[i]);
     if (!event.clipped && lit_peaks[i] >= kClipLevels) continue;
     const float* values = &corrected[i * frames_in_ring];
-    for (size_t j = 0; j < frames_in_ring; ++j) dating_series[j] += static_cast<double>(values[j]);
+    for (size_t j = 0; j < count; ++j) dating_series[j] += static_cast<double>(values[j]);
   }
   std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
   event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
   // the levels: the medians of the frames before and after (the pixels of a small light
   // may still be catching up after it: the creep widens the partly lit frame's band)
   const WindowShape shape =
-      ShapeOf(dating_series.data(), kBeforeFrames, after_frames, rise,
+      ShapeOf(dating_series.data(), kBeforeFrames, gap, after_frames, rise,
               std::max(options.threshold_frac, kPartlyLitBeforeFrac), window_copy);
   if (!(shape.step > 0)) return false;
   const double widest = std::max(shape.before_spread, shape.after_against);
@@ -858,7 +874,8 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, bool rise, StepEvent& event) {
   if (!(event.on > event.off)) return false;
   event.noise = 0.5 * widest;
   event.creep = shape.after_creep / (event.on - event.off);
-  event.value = dating_series;
+  event.value.assign(dating_series.begin(),
+                     dating_series.begin() + static_cast<std::ptrdiff_t>(count));
   event.off_levels = off_sum / (3.0 * static_cast<double>(pixels));
   event.on_levels = on_sum / (3.0 * static_cast<double>(pixels));
   return true;
@@ -944,12 +961,12 @@ void LedDetector::Impl::Evaluate() {
 
 template <typename T>
 double LedDetector::Impl::WindowStep(const std::vector<T>& series, size_t stride, size_t offset,
-                                     int64_t k, bool rise, std::vector<T>& window) const {
-  for (int i = 0; i < ring; ++i) {
-    window[static_cast<size_t>(i)] = series[Slot(k - kBeforeFrames + i) * stride + offset];
+                                     int64_t k, bool rise, std::vector<T>& scratch) const {
+  for (int i = 0; i < window; ++i) {
+    scratch[static_cast<size_t>(i)] = series[Slot(k - kBeforeFrames + i) * stride + offset];
   }
-  const double before = MedianOf(window.data(), kBeforeFrames);
-  const double after = MedianOf(window.data() + kBeforeFrames + 1, after_frames);
+  const double before = MedianOf(scratch.data(), kBeforeFrames);
+  const double after = MedianOf(scratch.data() + kBeforeFrames + 1, after_frames);
   return rise ? after - before : before - after;
 }
 
@@ -970,17 +987,17 @@ double LedDetector::Impl::Contrast(int region, int64_t k, bool rise) {
 
 std::optional<WindowShape> LedDetector::Impl::CleanStep(int region, int64_t k, bool rise,
                                                         double min_step) {
-  const auto count = static_cast<size_t>(ring);
+  const auto count = static_cast<size_t>(window);
   for (size_t i = 0; i < count; ++i) {
     window_values[i] = region_sums[RegionSlot(region, k - kBeforeFrames + static_cast<int64_t>(i))];
   }
   const auto before = window_values.cbegin();
   const auto before_end = before + kBeforeFrames;
   const auto after = before_end + 1;
-  const auto after_end = window_values.cend();
+  const auto after_end = before + static_cast<std::ptrdiff_t>(count);
   const auto [before_low, before_high] = std::minmax_element(before, before_end);
   const auto [after_low, after_high] = std::minmax_element(after, after_end);
-  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, after_frames, rise,
+  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, 1, after_frames, rise,
                                     options.threshold_frac, window_copy);
   const double step = shape.step;
   if (step < min_step) return std::nullopt;
@@ -1015,7 +1032,7 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
 
   // the LED's contrast: enough, and larger than the frame's other regions'
   StepEvent event;
-  if (!located && !MeasureRoiStep(k, rise, event)) return;
+  if (!located && !MeasureRoiStep(k, 1, rise, event)) return;
   const double contrast = located ? Contrast(region, k, rise) : event.contrast_levels;
   if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
   if (contrast < outlier_contrast && (located || event.standout < kLocalStandout)) return;
@@ -1176,7 +1193,7 @@ Status LedDetector::Impl::Process(const Frame& frame) {
   }
   Confirm(slot);
   ++frames;
-  if (frames >= ring) Evaluate();
+  if (frames >= window) Evaluate();
   return Status::Ok();
 }
 
