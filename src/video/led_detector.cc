@@ -234,6 +234,9 @@ struct StepEvent {
   double standout = 0.0;  // with an ROI: largest pixel step over the ROI's usual (kLocalStandout)
   double off_levels = 0.0, on_levels = 0.0;  // the region's mean, grey levels
   int64_t period_ns = 0;         // usual frame interval at the time
+  // with an ROI: the frames between the levels of a build-up (from index[kBeforeFrames] on;
+  // 1 for a step), whose first one's lit fraction a codec may have held at any level
+  int build_up_frames = 1;
   std::vector<int64_t> index, t_ns;
   std::vector<double> value;
   std::array<float, 16> cell_steps{};  // auto: the 4 x 4 cells around the block
@@ -448,6 +451,22 @@ struct LedDetector::Impl {
   // the step test for frame k = newest - after_frames, every region
   void Evaluate();
 
+  // With an ROI: a switch-on that a codec built up over 2 .. kBuildUpFrames frames (a small
+  // spot held at a partial level, or wobbling, before it settles), which no window of one
+  // step frame sees as clean: the kBeforeFrames frames before at the old level, the newest
+  // after_frames at the new one, every frame between lit (above kLitFraction of the step,
+  // below the new level by no more than creep allows). The longest such build-up ending now
+  // is tested as a step is (it stands out, looks like a light, enough contrast, then holds)
+  // and replaces a step still being confirmed that began inside it.
+  void TestBuildUp();
+  // the signal's shape for a build-up of `gap` frames from `first`, when it is one
+  std::optional<WindowShape> BuildUpShape(int64_t first, int gap, double min_step);
+  // whether a rise may start at `first`: the ROI is not at a high level, or only by a step
+  // still being confirmed that began after `first` (which is then dropped; not one whose
+  // partly lit frame before it is `first`: that step dates the same frame, its fraction
+  // measured)
+  bool RiseMayStartAt(int64_t first);
+
   // the step of one series of the ring (medians of the windows before and after k),
   // signed so that the step's direction is positive
   template <typename T>
@@ -467,8 +486,9 @@ struct LedDetector::Impl {
   // frames cross the threshold only at k; nullopt otherwise
   std::optional<WindowShape> CleanStep(int region, int64_t k, bool rise, double min_step);
   // the event's signal, frames and (located) levels; false when it does not look like a light
-  bool DescribeEvent(int region, int64_t k, bool rise, const WindowShape& shape, double contrast,
-                     StepEvent& event);
+  // (`gap` frames from k on between the levels: 1 for a step)
+  bool DescribeEvent(int region, int64_t k, int gap, bool rise, const WindowShape& shape,
+                     double contrast, StepEvent& event);
 
   // the step of each of the 4 x 4 cells around the block (medians of the same windows)
   void RecordCellSteps(StepEvent& event, int64_t k);
@@ -959,6 +979,82 @@ void LedDetector::Impl::Evaluate() {
   }
 }
 
+void LedDetector::Impl::TestBuildUp() {
+  const int64_t newest = frames - 1;
+  const double min_step = kMinStepLevels * 3.0 * pixels_per_region;
+  const int64_t longest = std::min<int64_t>(kBuildUpFrames, frames - kBeforeFrames - after_frames);
+  for (auto gap = static_cast<int>(longest); gap >= 2; --gap) {
+    const int64_t first = newest - after_frames - gap + 1;
+    const std::optional<WindowShape> shape = BuildUpShape(first, gap, min_step);
+    if (!shape) continue;
+    // it stands out from the frame and looks like a light, as a step must
+    const double jump =
+        region_sums[RegionSlot(0, first + 1)] - region_sums[RegionSlot(0, first - 1)];
+    if (jump < OutlierJump(first)) return;
+    StepEvent event;
+    if (!MeasureRoiStep(first, gap, true, event)) return;
+    const double contrast = event.contrast_levels;
+    if (contrast < OutlierContrast(first) && event.standout < kLocalStandout) return;
+    if (contrast < options.min_contrast_levels) {
+      if (contrast > std::max(rejected_contrast, 0.0)) {
+        rejected_contrast = contrast;
+        rejected_region = 0;
+      }
+      return;
+    }
+    if (!RiseMayStartAt(first) || events_per_region[0] >= kMaxEventsPerRegion) return;
+    DescribeEvent(0, first, gap, true, *shape, contrast, event);
+    event.frames_to_confirm = kConfirmFrames;
+    event.level_before = level[0];
+    event.level_step_before = level_step[0];
+    level[0] = Level::kHigh;
+    level_step[0] = static_cast<float>(shape->step);
+    ++events_per_region[0];
+    pending.push_back(std::move(event));
+    return;
+  }
+}
+
+std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int gap,
+                                                           double min_step) {
+  const auto count = static_cast<size_t>(kBeforeFrames + gap + after_frames);
+  for (size_t i = 0; i < count; ++i) {
+    window_values[i] = region_sums[RegionSlot(0, first - kBeforeFrames + static_cast<int64_t>(i))];
+  }
+  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, gap, after_frames, true,
+                                    kLitFraction, window_copy);
+  const double step = shape.step;
+  if (step < min_step || step <= kNoiseFactor * static_cast<double>(region_noise[0])) {
+    return std::nullopt;
+  }
+  const double flat = FlatFrac();
+  if (shape.before_spread > flat * step || shape.after_against > flat * step ||
+      shape.after_creep > kCreepFrac * step) {
+    return std::nullopt;
+  }
+  const auto fraction = [&](size_t i) { return (window_values[i] - shape.before_level) / step; };
+  const auto before = static_cast<size_t>(kBeforeFrames);
+  if (fraction(before - 1) >= kLitFraction) return std::nullopt;
+  for (size_t i = before; i < before + static_cast<size_t>(gap); ++i) {
+    if (fraction(i) < kLitFraction || fraction(i) > 1.0 + kCreepFrac) return std::nullopt;
+  }
+  return shape;
+}
+
+bool LedDetector::Impl::RiseMayStartAt(int64_t first) {
+  if (level[0] != Level::kHigh) return true;
+  const int64_t first_t_ns = ring_t_ns[Slot(first)];
+  const auto later = std::find_if(pending.begin(), pending.end(), [&](const StepEvent& event) {
+    return event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
+  });
+  if (later == pending.end()) return false;
+  level[0] = later->level_before;
+  level_step[0] = later->level_step_before;
+  --events_per_region[0];
+  pending.erase(later);
+  return true;
+}
+
 template <typename T>
 double LedDetector::Impl::WindowStep(const std::vector<T>& series, size_t stride, size_t offset,
                                      int64_t k, bool rise, std::vector<T>& scratch) const {
@@ -1037,7 +1133,7 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   if (outlier_contrast < 0) outlier_contrast = OutlierContrast(k);
   if (contrast < outlier_contrast && (located || event.standout < kLocalStandout)) return;
   if (contrast < options.min_contrast_levels) {
-    if (rise && contrast > rejected_contrast) {
+    if (rise && contrast > std::max(rejected_contrast, 0.0)) {
       rejected_contrast = contrast;
       rejected_region = region;
     }
@@ -1046,7 +1142,7 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
 
   // the event, pending confirmation; the region takes its new level meanwhile
-  if (!DescribeEvent(region, k, rise, *shape, contrast, event)) return;
+  if (!DescribeEvent(region, k, 1, rise, *shape, contrast, event)) return;
   event.frames_to_confirm = kConfirmFrames;
   event.level_before = level[static_cast<size_t>(region)];
   event.level_step_before = level_step[static_cast<size_t>(region)];
@@ -1056,8 +1152,8 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   pending.push_back(std::move(event));
 }
 
-bool LedDetector::Impl::DescribeEvent(int region, int64_t k, bool rise, const WindowShape& shape,
-                                      double contrast, StepEvent& event) {
+bool LedDetector::Impl::DescribeEvent(int region, int64_t k, int gap, bool rise,
+                                      const WindowShape& shape, double contrast, StepEvent& event) {
   const double step = shape.step;
   const double off = rise ? shape.before_level : shape.after_level;
   event.region = region;
@@ -1067,7 +1163,8 @@ bool LedDetector::Impl::DescribeEvent(int region, int64_t k, bool rise, const Wi
   event.signal_on = off + step;
   event.contrast_levels = contrast;
   event.period_ns = PeriodNs();
-  for (int64_t frame = k - kBeforeFrames; frame <= k + after_frames; ++frame) {
+  event.build_up_frames = gap;
+  for (int64_t frame = k - kBeforeFrames; frame < k + gap + after_frames; ++frame) {
     event.index.push_back(ring_index[Slot(frame)]);
     event.t_ns.push_back(ring_t_ns[Slot(frame)]);
   }
@@ -1194,6 +1291,7 @@ Status LedDetector::Impl::Process(const Frame& frame) {
   Confirm(slot);
   ++frames;
   if (frames >= window) Evaluate();
+  if (!located) TestBuildUp();
   return Status::Ok();
 }
 
@@ -1231,10 +1329,14 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
       }
     }
     if (lit >= 2 && fraction(lit - 1) > lit_above && fraction(lit) >= 1.0 - band) --lit;
+    // a build-up: its first frame, lit for an unknown part of its exposure (a codec held it)
+    const bool built_up = event.build_up_frames > 1;
+    if (built_up) lit = kBeforeFrames;
     const double f = std::clamp(fraction(lit), 0.0, 1.0);
     const internal::SwitchOnDating dating = internal::DateSwitchOn(
         static_cast<double>(event.t_ns[lit - 1]), dark, static_cast<double>(event.t_ns[lit]),
-        lit_band(f), exposure, static_cast<double>(event.period_ns));
+        built_up ? LitFraction{0.0, 1.0} : lit_band(f), exposure,
+        static_cast<double>(event.period_ns));
     pulse.on_ns = static_cast<int64_t>(std::llround(dating.estimate_ns));
     pulse.on_uncertainty_ns = dating.HalfWidth();
     pulse.missing_frames_before_on = dating.missing_frames;
@@ -1353,6 +1455,7 @@ Result<LedResult> LedDetector::Impl::Finish() const {
   result.trace_brightness_levels = trace_brightness_levels;
   bool first_rise_seen = false;
   bool already_on = false;
+  int first_build_up_frames = 1;
   for (const StepEvent* step : steps) {
     const StepEvent& event = *step;
     if (event.region != best || event.contrast_levels < kEligibleContrastFrac * best_contrast) {
@@ -1373,6 +1476,7 @@ Result<LedResult> LedDetector::Impl::Finish() const {
       result.on_level = event.on_levels;
       result.contrast_levels = event.contrast_levels;
       result.roi_px = located ? LocatedRect(event) : options.roi_px;
+      first_build_up_frames = event.build_up_frames;
     }
     result.pulses.push_back(DatePulse(event));
   }
@@ -1384,6 +1488,15 @@ Result<LedResult> LedDetector::Impl::Finish() const {
         "): dated as seen by the first missing frame; its +- " +
         FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) +
         " ms covers the whole gap");
+  }
+  if (first_build_up_frames > 1) {
+    const LedPulse& first = result.pulses.front();
+    result.warnings.push_back(
+        "built up over " + std::to_string(first_build_up_frames) + " frames from frame " +
+        std::to_string(first.first_lit_frame) +
+        " (a codec held the light at a partial level or let it wobble): dated from the first "
+        "frame that changed, lit for an unknown part of its exposure, +- " +
+        FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) + " ms");
   }
   if (already_on) {
     result.warnings.push_back(

@@ -48,10 +48,12 @@
 // step many regions at once; with an ROI, a step whose largest pixel step is 4 times the
 // ROI's usual one stands out however the frame changed), and the signal then holds its
 // new level (with an ROI, or goes on rising), or returns to the old one, for 8 more frames. A
-// region's steps under half the contrast of its brightest switch-on are not pulses. Limits: in an
-// ROI where no LED ever lights, a codec's update of a still block by a few grey levels can pass for
-// a dim LED; a small, dim LED under strong camera shake is missed rather than mistaken; located, a
-// 1 px LED under flicker and shake loses to larger steps.
+// region's steps under half the contrast of its brightest switch-on are not pulses. With an ROI a
+// switch-on a codec built up over 2 to 12 frames (held at a partial level, or wobbling) counts
+// too, dated from its first frame lit for an unknown part of its exposure, with a warning. Limits:
+// in an ROI where no LED ever lights, a codec's update of a still block by a few grey levels can
+// pass for a dim LED; a small, dim LED under strong camera shake is missed rather than mistaken;
+// located, a 1 px LED under flicker and shake loses to larger steps.
 #pragma once
 
 #include <cstdint>
@@ -120,7 +122,7 @@ struct LedResult {
   std::string Brief() const;
 };
 
-/// Streams frames in decode order; no frame is kept (with an ROI, its last 5 +
+/// Streams frames in decode order; no frame is kept (with an ROI, its last 16 +
 /// min_on_frames pictures and the 16-byte trace entry per frame; the automatic locator
 /// keeps O(1) state per image cell, never frames).
 class LedDetector {
