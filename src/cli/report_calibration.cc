@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -71,9 +72,15 @@ std::string CacheOptions(const ReportCommand& command) {
          std::to_string(mc.seed) + " " + FormatNumber(mc.stddev_scale);
 }
 
-// the cached grid and Monte Carlo, when the file is there and made with these options
-std::optional<std::pair<std::vector<fit::TensionSample>, std::vector<fit::TensionSample>>>
-LoadCachedRuns(const fs::path& path, const std::string& options) {
+// The cache file's runs: the grid, the Monte Carlo and, with --fit-ratio, the grid again at
+// each other stiffness ratio (by its Buna-N multiplier; older files have none).
+struct CachedRuns {
+  std::vector<fit::TensionSample> grid, monte_carlo;
+  std::map<double, std::vector<fit::TensionSample>> ratio_grids;
+};
+
+// the cached runs, when the file is there and made with these options
+std::optional<CachedRuns> LoadCachedRuns(const fs::path& path, const std::string& options) {
   if (!fs::exists(path)) return std::nullopt;
   auto document = LoadJsonFile(path);
   if (!document.ok() || !document->is_object() || document->value("format", "") != kCacheFormat ||
@@ -84,7 +91,33 @@ LoadCachedRuns(const fs::path& path, const std::string& options) {
   auto grid = fit::TensionSamplesFromJson((*document)["grid"], path.string());
   auto monte_carlo = fit::TensionSamplesFromJson((*document)["monte_carlo"], path.string());
   if (!grid.ok() || !monte_carlo.ok()) return std::nullopt;
-  return std::make_pair(std::move(grid).value(), std::move(monte_carlo).value());
+  CachedRuns runs{std::move(grid).value(), std::move(monte_carlo).value(), {}};
+  const json& ratios = document->value("ratio_grids", json::array());
+  if (!ratios.is_array()) return std::nullopt;
+  for (const json& entry : ratios) {
+    if (!entry.is_object() || !entry.contains("ratio") || !entry["ratio"].is_number() ||
+        !entry.contains("grid")) {
+      return std::nullopt;
+    }
+    auto ratio_grid = fit::TensionSamplesFromJson(entry["grid"], path.string());
+    if (!ratio_grid.ok()) return std::nullopt;
+    runs.ratio_grids[entry["ratio"].get<double>()] = std::move(ratio_grid).value();
+  }
+  return runs;
+}
+
+Status SaveCachedRuns(const fs::path& path, const std::string& options, const CachedRuns& runs) {
+  json ratio_grids = json::array();
+  for (const auto& [ratio, grid] : runs.ratio_grids) {
+    ratio_grids.push_back({{"ratio", ratio}, {"grid", fit::TensionSamplesToJson(grid)}});
+  }
+  const json document = {{"format", kCacheFormat},
+                         {"version", kCacheVersion},
+                         {"options", options},
+                         {"grid", fit::TensionSamplesToJson(runs.grid)},
+                         {"monte_carlo", fit::TensionSamplesToJson(runs.monte_carlo)},
+                         {"ratio_grids", std::move(ratio_grids)}};
+  return WriteJsonFile(path, document);
 }
 
 // the grid and Monte Carlo runs, from the cache or simulated (the Monte Carlo's taken
@@ -95,8 +128,8 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
                       std::ostream& err) {
   const std::string options = CacheOptions(command);
   if (auto cached = LoadCachedRuns(result.cache_path, options)) {
-    result.grid = std::move(cached->first);
-    result.monte_carlo = std::move(cached->second);
+    result.grid = std::move(cached->grid);
+    result.monte_carlo = std::move(cached->monte_carlo);
     result.from_cache = true;
     return Status::Ok();
   }
@@ -125,12 +158,7 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
     err << "calibration: " << (grid.size() + draws.size()) * sweep.feet.size() << " runs in "
         << FormatFixed(wall.count(), 2) << " s wall\n";
   }
-  const json document = {{"format", kCacheFormat},
-                         {"version", kCacheVersion},
-                         {"options", options},
-                         {"grid", fit::TensionSamplesToJson(result.grid)},
-                         {"monte_carlo", fit::TensionSamplesToJson(result.monte_carlo)}};
-  return WriteJsonFile(result.cache_path, document);
+  return SaveCachedRuns(result.cache_path, options, {result.grid, result.monte_carlo, {}});
 }
 
 // the campaign's calibration with the fitted point among its tension points, in sigma
@@ -355,22 +383,40 @@ std::string MarkdownToHtml(const std::string& markdown) {
 namespace {
 
 // The stiffness ratio: the tension scale's grid run again at each ratio but 1 (the grid
-// itself), and the profile fitted. A ratio that cannot be fitted is a result
-// (ratio_status); a simulation that fails is an error.
+// itself), or taken from the cache (and cached), and the profile fitted. A ratio that cannot
+// be fitted is a result (ratio_status); a simulation that fails is an error.
 Status FitRatio(const ReportCommand& command, const Calibration& calibration,
                 const sim::ModelDescription& model, const sim::SweepOptions& sweep,
-                ReportCalibration& result) {
+                ReportCalibration& result, std::ostream& err) {
+  const std::string options = CacheOptions(command);
+  CachedRuns cache = LoadCachedRuns(result.cache_path, options)
+                         .value_or(CachedRuns{result.grid, result.monte_carlo, {}});
+  std::vector<double> missing;
+  for (double ratio : command.ratio.ratios) {
+    if (ratio != 1.0 && !cache.ratio_grids.count(ratio)) missing.push_back(ratio);
+  }
+  if (!missing.empty()) {
+    const bool progress = command.sweep.experiment.progress != "off";
+    if (progress) {
+      err << "calibration: simulating the grid at "
+          << Plural(static_cast<int64_t>(missing.size()), "stiffness ratio") << "\n";
+    }
+    const auto start = std::chrono::steady_clock::now();
+    for (double ratio : missing) {
+      const std::vector<TensionPoint> points =
+          fit::GridTensionPoints(fit::ScaledBunaN(calibration.tension_points, ratio), command.fit);
+      LIFTOFF_ASSIGN_OR_RETURN(cache.ratio_grids[ratio],
+                               fit::SimulateTensions(model, sweep, points));
+    }
+    if (progress) {
+      const std::chrono::duration<double> wall = std::chrono::steady_clock::now() - start;
+      err << "calibration: stiffness ratios in " << FormatFixed(wall.count(), 2) << " s wall\n";
+    }
+    LIFTOFF_RETURN_IF_ERROR(SaveCachedRuns(result.cache_path, options, cache));
+  }
   std::vector<std::vector<fit::TensionSample>> grids;
   for (double ratio : command.ratio.ratios) {
-    if (ratio == 1.0) {
-      grids.push_back(result.grid);
-      continue;
-    }
-    const std::vector<TensionPoint> points =
-        fit::GridTensionPoints(fit::ScaledBunaN(calibration.tension_points, ratio), command.fit);
-    LIFTOFF_ASSIGN_OR_RETURN(std::vector<fit::TensionSample> grid,
-                             fit::SimulateTensions(model, sweep, points));
-    grids.push_back(std::move(grid));
+    grids.push_back(ratio == 1.0 ? result.grid : cache.ratio_grids.at(ratio));
   }
   auto fitted = fit::FitStiffnessRatio(result.targets, grids, command.fit, command.ratio);
   if (fitted.ok()) {
@@ -438,7 +484,7 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
   result.at_fit = at_fit.front();
   result.fitted = FittedCalibration(calibration, *result.fit, command.manifest_path.string());
   if (command.fit_ratio) {
-    LIFTOFF_RETURN_IF_ERROR(FitRatio(command, calibration, model, sweep, result));
+    LIFTOFF_RETURN_IF_ERROR(FitRatio(command, calibration, model, sweep, result, err));
   }
   return result;
 }

@@ -35,6 +35,7 @@ using liftoff::testing::ScratchDir;
 using liftoff::testing::SourceDir;
 using liftoff::testing::WriteFile;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 CommandRun RunReportCommand(const ReportCommand& command) {
   return liftoff::testing::RunInProcess(RunReport, command);
@@ -387,6 +388,33 @@ TEST(CliReport, FitRatioProfilesTheStiffnessRatioInCalibrationMd) {
   for (const char* row : {"| 0.50 | ", "| 1.00 | ", "| 2.00 | "}) {
     EXPECT_THAT(markdown, HasSubstr(row)) << row;
   }
+
+  // the ratios' grids are cached beside the grid's: a second run simulates none, and one
+  // more ratio is the only one simulated
+  std::vector<fs::path> caches;
+  for (const auto& entry : fs::directory_iterator(scratch / "report" / "sim-cache")) {
+    if (entry.path().string().ends_with(".calibration.json")) caches.push_back(entry.path());
+  }
+  ASSERT_EQ(caches.size(), 1u);
+  auto cache = LoadJsonFile(caches.front());
+  ASSERT_TRUE(cache.ok()) << cache.status().ToString();
+  ASSERT_EQ((*cache)["ratio_grids"].size(), 2u);
+  EXPECT_EQ((*cache)["ratio_grids"][0]["ratio"], 0.5);
+  EXPECT_EQ((*cache)["ratio_grids"][1]["ratio"], 2.0);
+  command.sweep.experiment.progress = "lines";
+  const CommandRun cached = RunReportCommand(command);
+  ASSERT_EQ(cached.code, kExitOk) << cached.err;
+  EXPECT_THAT(cached.err, Not(HasSubstr("stiffness ratio")));
+  // (the same page but for where its runs came from)
+  std::string again = ReadFile(scratch / "report" / "calibration.md");
+  const std::string read = "(read from it)";
+  ASSERT_NE(again.find(read), std::string::npos);
+  EXPECT_EQ(again.replace(again.find(read), read.size(), "(run now)"), markdown);
+  command.ratio.ratios = {0.5, 1.0, 2.0, 4.0};
+  const CommandRun one_more = RunReportCommand(command);
+  ASSERT_EQ(one_more.code, kExitOk) << one_more.err;
+  EXPECT_THAT(one_more.err, HasSubstr("calibration: simulating the grid at 1 stiffness ratio\n"));
+  EXPECT_THAT(ReadFile(scratch / "report" / "calibration.md"), HasSubstr("| 4.00 | "));
 
   command = SampleReport(scratch / "refused");
   command.fit_ratio = true;

@@ -40,7 +40,7 @@ struct ReportCommand {
   fit::FitOptions fit;
   fit::MonteCarloOptions monte_carlo;
   /// Also fit the ratio of the Buna-N and silicone stiffnesses: the tension scale's grid
-  /// run again at each of ratio.ratios but 1 (those runs are not cached).
+  /// run again at each of ratio.ratios but 1 (cached with the grid's runs, by ratio).
   bool fit_ratio = false;
   fit::RatioFitOptions ratio;
   /// The gnuplot program (found on the PATH unless a path is given).
