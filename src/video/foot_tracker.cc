@@ -1338,6 +1338,25 @@ std::string CheckLostRise(const std::vector<HeightSample>& samples, const PatchS
          " patches: the liftoff lies between " + FormatFixed(early_s, 3) + " s and that crossing";
 }
 
+// A foot measured by fewer than kFewFootPatches patches may be measured short: a small foot's
+// patches that hold some still ground or its contact shadow follow a fraction of its rise
+// (hard3d-06 with --rise-slowdown 3, --seed 10000: 0.18 px at a key frame where the foot was
+// 0.75 px up, 242 ms late). A rise measured short starts at the same instant, so the liftoff
+// lies between the fit's earliest knee and the crossing: the interval reaches down to the
+// knee, its instant unchanged. Returns why, or "".
+std::string ReachDownToTheKnee(const PatchSelection& selection, const internal::RiseFit& fit,
+                               double crossing_s, double& uncertainty_s) {
+  if (selection.foot.size() >= kFewFootPatches || !std::isfinite(crossing_s) ||
+      !(fit.knee_low_s < crossing_s - uncertainty_s)) {
+    return "";
+  }
+  uncertainty_s = crossing_s - fit.knee_low_s;
+  return "a foot seen by " + PatchCount(selection.foot.size()) +
+         " may be measured short (patches holding still ground): the liftoff may be as early "
+         "as the rise's start at " +
+         FormatFixed(fit.knee_low_s, 3) + " s";
+}
+
 // How far the ground's level (the shake, a median over kSmoothHalfS either side) moved from
 // the rest frames to the crossing at crossing_s, px. A still camera's ground does not move:
 // a drift that comes with the rise is a shadow or a part of the robot among the ground
@@ -1386,6 +1405,7 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
       CheckSinking(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string lost =
       CheckLostRise(samples, selection, search, track, crossing_s, uncertainty_s);
+  const std::string few = ReachDownToTheKnee(selection, fit, crossing_s, uncertainty_s);
   // (bounded: a nearly flat model at the crossing must not overflow the nanoseconds)
   track.above_threshold =
       MakeEvent(samples, crossing_s, std::min(uncertainty_s, kLongestUncertaintyS));
@@ -1395,7 +1415,7 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.fit_last_frame = samples[search.fit_last].frame_index;
   track.fit_noise_px = fit.noise;
   AddConfidenceWarnings(track, selection, fit, uncertainty_s);
-  for (const std::string& why : {disagreed, sank, lost}) {
+  for (const std::string& why : {disagreed, sank, lost, few}) {
     if (why.empty()) continue;
     track.warnings.push_back("low confidence: " + why);
     track.low_confidence = true;

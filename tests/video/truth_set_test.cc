@@ -96,6 +96,12 @@ ClipScore ScoreClip(const fs::path& folder) {
     EXPECT_EQ(warning.find("foot: foot:"), std::string::npos) << warning;
   }
   score.low_confidence = analysis->foot && analysis->foot->low_confidence;
+  // a foot seen by fewer than 3 patches may be measured short: its interval reaches down to
+  // the rise's start (the fit's earliest knee, at or before the onset)
+  if (analysis->foot && analysis->foot->foot_patches_px.size() < 3) {
+    const TimedEvent& lift = analysis->foot->above_threshold;
+    EXPECT_LE(lift.t_ns - lift.uncertainty_ns, analysis->foot->onset.t_ns) << score.id;
+  }
   return score;
 }
 
