@@ -328,18 +328,28 @@ void ExpectOnePulseWithinHalfAFrame(const TinyLedStream& stream) {
       << result->Brief();
 }
 
+// The stream's ROI gives one pulse, its switch-on within half a frame of the truth and
+// inside its interval: the result, or nullopt (with a failure) when it is not one pulse.
+std::optional<LedResult> DetectOnePulseAroundTheTruth(const TinyLedStream& stream) {
+  auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  EXPECT_TRUE(result.ok()) << result.status().ToString();
+  if (!result.ok()) return std::nullopt;
+  EXPECT_EQ(result->pulses.size(), 1u) << result->Brief();
+  if (result->pulses.size() != 1) return std::nullopt;
+  const LedPulse& pulse = result->pulses[0];
+  const double error_ns = static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9;
+  EXPECT_LE(std::abs(error_ns), 0.5 * stream.PeriodNs()) << result->Brief();
+  EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
+  return std::move(result).value();
+}
+
 TEST(LedDetector, FindsATinySaturatingLedInABigFlickeringNoisyRegion) {
   TinyLedStream stream;
   // frame 45 (1.5 s) exposes [1.5 - 0.35 T, 1.5 + 0.35 T): on 30 % of the way into it
   const double exposure_s = stream.exposure_s;
   stream.on_s = 1.5 - 0.5 * exposure_s + 0.3 * exposure_s;
-  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
-  ASSERT_TRUE(result.ok()) << result.status().ToString();
-  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
-  const LedPulse& pulse = result->pulses[0];
-  const double error_ns = static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9;
-  EXPECT_LE(std::abs(error_ns), 0.5 * stream.PeriodNs()) << result->Brief();
-  EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
+  const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
+  ASSERT_TRUE(result);
   EXPECT_GE(result->contrast_levels, 100.0);
 }
 
@@ -388,31 +398,33 @@ TEST(LedDetector, ALedThatGoesOnBrighteningIsOneSwitchOn) {
   ExpectOnePulseWithinHalfAFrame(stream);
 }
 
+// A faint tiny LED on a frozen (noiseless, flicker-free) picture, switched on half way into
+// frame 45's exposure, its first lit frames shown at `build_up` of what they saw.
+TinyLedStream FrozenFaintLed(std::vector<double> build_up) {
+  TinyLedStream stream;
+  stream.noise_sigma = 0.0;
+  stream.flicker = false;
+  stream.light_scale = 0.05;
+  stream.build_up = std::move(build_up);
+  stream.on_s = 1.5;
+  return stream;
+}
+
 // A faint tiny LED on a frozen picture, half lit in frame 45 and built up by H.264 over
 // three frames (hard3d-06 re-drawn with --seed 4000: its brightest pixel shown 0.67, 0.80,
 // 0.93 of its level, the ROI's signal 0.40, 0.60, 0.88; here 0.6, 0.7, 0.9): the frame
 // after a partly lit one still short of the level is the codec, not a transition to come.
 TEST(LedDetector, AFaintLedACodecBuildsUpOverFramesIsFound) {
-  TinyLedStream stream;
-  stream.noise_sigma = 0.0;
-  stream.flicker = false;
-  stream.light_scale = 0.05;
-  stream.build_up = {1.2, 0.7, 0.9};
-  stream.on_s = 1.5;
-  ExpectOnePulseWithinHalfAFrame(stream);
+  ExpectOnePulseWithinHalfAFrame(FrozenFaintLed({1.2, 0.7, 0.9}));
 }
 
 // A build-up the one-step window cannot see (hard3d-06 drawn with --rise-slowdown 3): the
 // detector dates the first frame that changed, lit for an unknown part of its exposure, and
 // says so.
 void ExpectABuiltUpSwitchOn(const TinyLedStream& stream) {
-  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
-  ASSERT_TRUE(result.ok()) << result.status().ToString();
-  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
+  ASSERT_TRUE(result);
   const LedPulse& pulse = result->pulses[0];
-  const double error_ns = static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9;
-  EXPECT_LE(std::abs(error_ns), 0.5 * stream.PeriodNs()) << result->Brief();
-  EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
   EXPECT_EQ(pulse.first_lit_frame, 45) << result->Brief();
   // with the exposure unknown: from frame 44's timestamp to half a frame after frame 45's
   const double t45_ns = 45 * stream.PeriodNs();
@@ -427,26 +439,15 @@ void ExpectABuiltUpSwitchOn(const TinyLedStream& stream) {
 // that for 7 frames and caught up over 3 (seed 10000, where the switch-on also came with a
 // renewal of the whole picture): the catch-up alone is a clean step, 8 frames late.
 TEST(LedDetector, ALedACodecHoldsAtAPartialLevelIsDatedFromItsFirstFrame) {
-  TinyLedStream stream;
-  stream.noise_sigma = 0.0;
-  stream.flicker = false;
-  stream.light_scale = 0.05;
+  TinyLedStream stream = FrozenFaintLed({1.2, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.75, 0.9});
   stream.refresh_levels = 2.0;
-  stream.build_up = {1.2, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.75, 0.9};
-  stream.on_s = 1.5;
   ExpectABuiltUpSwitchOn(stream);
 }
 
 // The LED's pixels wobbled by a third of the step for 6 frames after a half-lit switch-on
 // frame (seed 11000): no window of one step frame is flat after it.
 TEST(LedDetector, ALedThatWobblesAfterItsSwitchOnIsDatedFromItsFirstFrame) {
-  TinyLedStream stream;
-  stream.noise_sigma = 0.0;
-  stream.flicker = false;
-  stream.light_scale = 0.05;
-  stream.build_up = {1.0, 0.9, 0.75, 0.6, 0.7, 0.9};
-  stream.on_s = 1.5;
-  ExpectABuiltUpSwitchOn(stream);
+  ExpectABuiltUpSwitchOn(FrozenFaintLed({1.0, 0.9, 0.75, 0.6, 0.7, 0.9}));
 }
 
 TEST(LedDetector, ADroppedFrameAtTheSwitchOnWidensTheIntervalToTheRealTimestamps) {
