@@ -92,16 +92,16 @@ std::optional<CachedRuns> LoadCachedRuns(const fs::path& path, const std::string
   auto monte_carlo = fit::TensionSamplesFromJson((*document)["monte_carlo"], path.string());
   if (!grid.ok() || !monte_carlo.ok()) return std::nullopt;
   CachedRuns runs{std::move(grid).value(), std::move(monte_carlo).value(), {}};
-  const json& ratios = document->value("ratio_grids", json::array());
-  if (!ratios.is_array()) return std::nullopt;
-  for (const json& entry : ratios) {
+  // (a damaged entry of the ratios' grids costs that grid only: it is simulated again)
+  const json ratios = document->value("ratio_grids", json::array());
+  for (const json& entry : ratios.is_array() ? ratios : json::array()) {
     if (!entry.is_object() || !entry.contains("ratio") || !entry["ratio"].is_number() ||
         !entry.contains("grid")) {
-      return std::nullopt;
+      continue;
     }
     auto ratio_grid = fit::TensionSamplesFromJson(entry["grid"], path.string());
-    if (!ratio_grid.ok()) return std::nullopt;
-    runs.ratio_grids[entry["ratio"].get<double>()] = std::move(ratio_grid).value();
+    if (ratio_grid.ok())
+      runs.ratio_grids[entry["ratio"].get<double>()] = std::move(ratio_grid).value();
   }
   return runs;
 }
@@ -413,6 +413,7 @@ Status FitRatio(const ReportCommand& command, const Calibration& calibration,
       err << "calibration: stiffness ratios in " << FormatFixed(wall.count(), 2) << " s wall\n";
     }
     LIFTOFF_RETURN_IF_ERROR(SaveCachedRuns(result.cache_path, options, cache));
+    result.ratio_grids_run = static_cast<int>(missing.size());
   }
   std::vector<std::vector<fit::TensionSample>> grids;
   for (double ratio : command.ratio.ratios) {
@@ -629,15 +630,19 @@ std::string CalibrationMarkdown(const ReportCalibration& calibration, const std:
   if (!calibration.targets.empty()) text += FitMarkdown(calibration, command, heading);
   if (command.fit_ratio && calibration.fit) text += RatioMarkdown(calibration, heading);
   text += MonteCarloMarkdown(calibration, command, heading);
-  text += heading +
-          "# Files\n\n"
-          "- calibration.json: the campaign's calibration with the tension point \"fitted\" "
-          "(or, when the fit falls on one of its points, a note on that point; `liftoff calib "
-          "calibration.json`; absent without a fit)\n"
-          "- figures/fit and figures/montecarlo: .gp scripts with their .dat data\n"
-          "- simulated runs cached in " +
-          calibration.cache_path.string() +
-          (calibration.from_cache ? " (read from it)" : " (run now)") + "\n";
+  text +=
+      heading +
+      "# Files\n\n"
+      "- calibration.json: the campaign's calibration with the tension point \"fitted\" "
+      "(or, when the fit falls on one of its points, a note on that point; `liftoff calib "
+      "calibration.json`; absent without a fit)\n"
+      "- figures/fit and figures/montecarlo: .gp scripts with their .dat data\n"
+      "- simulated runs cached in " +
+      calibration.cache_path.string() + (calibration.from_cache ? " (read from it" : " (run now") +
+      (calibration.from_cache && calibration.ratio_grids_run > 0
+           ? "; the grid at " + Plural(calibration.ratio_grids_run, "stiffness ratio") + " run now)"
+           : ")") +
+      "\n";
   return text;
 }
 

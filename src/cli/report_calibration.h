@@ -48,6 +48,8 @@ struct ReportCalibration {
   /// Cache file of the simulated runs, and whether they came from it.
   std::filesystem::path cache_path;
   bool from_cache = false;
+  /// With --fit-ratio: the stiffness ratios whose grid was simulated now (not cached).
+  int ratio_grids_run = 0;
 };
 
 /// Calibrates the campaign: `values` (the trials) against the sweep's `sim` results and

@@ -1106,12 +1106,14 @@ double LiftoffUncertaintyS(const FootTrack& track, const LiftoffSearch& search,
 }
 
 // Warnings where the evidence is weak; low_confidence when any is.
+// (`few_patches_reach`: what a foot seen by few patches did to the interval, or "")
 void AddConfidenceWarnings(FootTrack& track, const PatchSelection& selection,
-                           const internal::RiseFit& fit, double uncertainty_s) {
+                           const internal::RiseFit& fit, double uncertainty_s,
+                           const std::string& few_patches_reach) {
   std::vector<std::string> weak;
   if (selection.foot.size() < kFewFootPatches) {
-    weak.push_back("only " + PatchCount(selection.foot.size()) +
-                   " moved with the foot");
+    weak.push_back("only " + PatchCount(selection.foot.size()) + " moved with the foot" +
+                   (few_patches_reach.empty() ? "" : ": " + few_patches_reach));
   }
   if (fit.noise > kNoisyFraction * track.threshold_px) {
     weak.push_back("the height curve is noisy (" + FormatFixed(fit.noise, 2) +
@@ -1343,7 +1345,8 @@ std::string CheckLostRise(const std::vector<HeightSample>& samples, const PatchS
 // (hard3d-06 with --rise-slowdown 3, --seed 10000: 0.18 px at a key frame where the foot was
 // 0.75 px up, 242 ms late). A rise measured short starts at the same instant, so the liftoff
 // lies between the fit's earliest knee and the crossing: the interval reaches down to the
-// knee, its instant unchanged. Returns why, or "".
+// knee, its instant unchanged (the interval is symmetric: it widens as far later). Returns
+// why, for the warning that the foot was seen by few patches, or "".
 std::string ReachDownToTheKnee(const PatchSelection& selection, const internal::RiseFit& fit,
                                double crossing_s, double& uncertainty_s) {
   if (selection.foot.size() >= kFewFootPatches || !std::isfinite(crossing_s) ||
@@ -1351,9 +1354,8 @@ std::string ReachDownToTheKnee(const PatchSelection& selection, const internal::
     return "";
   }
   uncertainty_s = crossing_s - fit.knee_low_s;
-  return "a foot seen by " + PatchCount(selection.foot.size()) +
-         " may be measured short (patches holding still ground): the liftoff may be as early "
-         "as the rise's start at " +
+  return "they may measure it short (holding still ground), so the liftoff may be as early as "
+         "the rise's start at " +
          FormatFixed(fit.knee_low_s, 3) + " s";
 }
 
@@ -1414,8 +1416,8 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   track.fit_first_frame = samples[search.fit_first].frame_index;
   track.fit_last_frame = samples[search.fit_last].frame_index;
   track.fit_noise_px = fit.noise;
-  AddConfidenceWarnings(track, selection, fit, uncertainty_s);
-  for (const std::string& why : {disagreed, sank, lost, few}) {
+  AddConfidenceWarnings(track, selection, fit, uncertainty_s, few);
+  for (const std::string& why : {disagreed, sank, lost}) {
     if (why.empty()) continue;
     track.warnings.push_back("low confidence: " + why);
     track.low_confidence = true;

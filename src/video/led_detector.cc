@@ -324,8 +324,10 @@ struct LedDetector::Impl {
   std::vector<double> region_sums;  // ring x regions
 
   // with an ROI: its last `ring` pictures (B, G, R), each pixel's reference brightness
-  // (B + G + R, following the frames that leave the ring, so a step is always measured
-  // against frames before it), how many of the largest changes the signal sums, scratch
+  // (B + G + R, following the frames that leave the step window, so a step is measured
+  // against frames before it; a build-up's later frames against a reference that has taken
+  // in its first ones at 1/64 a frame), how many of the largest changes the signal sums,
+  // scratch
   std::vector<uint8_t> roi_pictures;  // ring x ROI pixels x 3
   std::vector<float> pixel_reference;
   int64_t reference_frames = 0;
@@ -455,17 +457,20 @@ struct LedDetector::Impl {
   // spot held at a partial level, or wobbling, before it settles), which no window of one
   // step frame sees as clean: the kBeforeFrames frames before at the old level, the newest
   // after_frames at the new one, every frame between lit (above kLitFraction of the step,
-  // below the new level by no more than creep allows). The longest such build-up ending now
+  // above the new level by at most kCreepFrac of the step). The longest such build-up ending now
   // is tested as a step is (it stands out, looks like a light, enough contrast, then holds)
-  // and replaces a step still being confirmed that began inside it.
+  // and replaces the steps still being confirmed that began after its second frame.
   void TestBuildUp();
   // the signal's shape for a build-up of `gap` frames from `first`, when it is one
   std::optional<WindowShape> BuildUpShape(int64_t first, int gap, double min_step);
-  // whether a rise may start at `first`: the ROI is not at a high level, or only by a step
-  // still being confirmed that began after `first` (which is then dropped; not one whose
-  // partly lit frame before it is `first`: that step dates the same frame, its fraction
-  // measured)
-  bool RiseMayStartAt(int64_t first);
+  // whether a rise of `step` may start at `first`: the ROI is not at a high level, or only
+  // by a fainter step (as in Evaluate: kStrongerFactor), or by a step still being confirmed
+  // that began after `first` (not one whose partly lit frame before it is `first`: that step
+  // dates the same frame, its fraction measured)
+  bool RiseMayStartAt(int64_t first, double step) const;
+  // drops the rises still being confirmed that began after `first` (as RiseMayStartAt), the
+  // ROI's level back to what the earliest of them found
+  void DropRisesAfter(int64_t first);
 
   // the step of one series of the ring (medians of the windows before and after k),
   // signed so that the step's direction is positive
@@ -987,12 +992,20 @@ void LedDetector::Impl::TestBuildUp() {
     const int64_t first = newest - after_frames - gap + 1;
     const std::optional<WindowShape> shape = BuildUpShape(first, gap, min_step);
     if (!shape) continue;
-    // it stands out from the frame and looks like a light, as a step must
+    if (!RiseMayStartAt(first, shape->step) || events_per_region[0] >= kMaxEventsPerRegion) {
+      return;
+    }
+    // it stands out from the frame and looks like a light, as a step must, and its first
+    // frame is the first lit in the LED's own pixels too
     const double jump =
         region_sums[RegionSlot(0, first + 1)] - region_sums[RegionSlot(0, first - 1)];
     if (jump < OutlierJump(first)) return;
     StepEvent event;
     if (!MeasureRoiStep(first, gap, true, event)) return;
+    const auto dating_fraction = [&](size_t i) {
+      return (event.value[i] - event.off) / (event.on - event.off);
+    };
+    if (dating_fraction(kBeforeFrames - 1) >= kLitFraction) return;
     const double contrast = event.contrast_levels;
     if (contrast < OutlierContrast(first) && event.standout < kLocalStandout) return;
     if (contrast < options.min_contrast_levels) {
@@ -1002,7 +1015,7 @@ void LedDetector::Impl::TestBuildUp() {
       }
       return;
     }
-    if (!RiseMayStartAt(first) || events_per_region[0] >= kMaxEventsPerRegion) return;
+    DropRisesAfter(first);
     DescribeEvent(0, first, gap, true, *shape, contrast, event);
     event.frames_to_confirm = kConfirmFrames;
     event.level_before = level[0];
@@ -1041,18 +1054,33 @@ std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int ga
   return shape;
 }
 
-bool LedDetector::Impl::RiseMayStartAt(int64_t first) {
-  if (level[0] != Level::kHigh) return true;
+bool LedDetector::Impl::RiseMayStartAt(int64_t first, double step) const {
+  if (level[0] != Level::kHigh || step > kStrongerFactor * static_cast<double>(level_step[0])) {
+    return true;
+  }
   const int64_t first_t_ns = ring_t_ns[Slot(first)];
-  const auto later = std::find_if(pending.begin(), pending.end(), [&](const StepEvent& event) {
+  return std::any_of(pending.begin(), pending.end(), [&](const StepEvent& event) {
     return event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
   });
-  if (later == pending.end()) return false;
-  level[0] = later->level_before;
-  level_step[0] = later->level_step_before;
-  --events_per_region[0];
-  pending.erase(later);
-  return true;
+}
+
+void LedDetector::Impl::DropRisesAfter(int64_t first) {
+  const int64_t first_t_ns = ring_t_ns[Slot(first)];
+  const StepEvent* earliest = nullptr;
+  for (const StepEvent& event : pending) {
+    if (event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns &&
+        (!earliest || event.t_ns[kBeforeFrames] < earliest->t_ns[kBeforeFrames])) {
+      earliest = &event;
+    }
+  }
+  if (!earliest) return;
+  level[0] = earliest->level_before;
+  level_step[0] = earliest->level_step_before;
+  const auto dropped = std::remove_if(pending.begin(), pending.end(), [&](const StepEvent& event) {
+    return event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
+  });
+  events_per_region[0] -= static_cast<uint32_t>(std::distance(dropped, pending.end()));
+  pending.erase(dropped, pending.end());
 }
 
 template <typename T>

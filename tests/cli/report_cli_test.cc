@@ -415,6 +415,18 @@ TEST(CliReport, FitRatioProfilesTheStiffnessRatioInCalibrationMd) {
   ASSERT_EQ(one_more.code, kExitOk) << one_more.err;
   EXPECT_THAT(one_more.err, HasSubstr("calibration: simulating the grid at 1 stiffness ratio\n"));
   EXPECT_THAT(ReadFile(scratch / "report" / "calibration.md"), HasSubstr("| 4.00 | "));
+  EXPECT_THAT(ReadFile(scratch / "report" / "calibration.md"),
+              HasSubstr("(read from it; the grid at 1 stiffness ratio run now)"));
+  // a damaged ratio's grid costs that grid only: the grid and the Monte Carlo are kept
+  cache = LoadJsonFile(caches.front());
+  ASSERT_TRUE(cache.ok()) << cache.status().ToString();
+  ASSERT_EQ((*cache)["ratio_grids"].size(), 3u);
+  (*cache)["ratio_grids"][0]["grid"] = "damaged";
+  WriteFile(caches.front(), cache->dump());
+  const CommandRun mended = RunReportCommand(command);
+  ASSERT_EQ(mended.code, kExitOk) << mended.err;
+  EXPECT_THAT(mended.err, HasSubstr("calibration: simulating the grid at 1 stiffness ratio\n"));
+  EXPECT_THAT(ReadFile(scratch / "report" / "calibration.md"), HasSubstr("(read from it; "));
 
   command = SampleReport(scratch / "refused");
   command.fit_ratio = true;

@@ -17,14 +17,14 @@
 //
 // With an ROI the detector works on the ROI's pixels, so a 1 px LED in a region hundreds of
 // times its size is found: each pixel's B + G + R against its own reference (an average of
-// the frames that left a ring of the last 5 + min_on_frames, so a step is measured against frames
-// before it), each row's flicker gain taken out first (measured on the same rows beside the ROI, in
-// bands of 4 rows, interpolated: rolling-shutter banding), the ROI's outer 3 px left out
-// (shake carries what lies just outside into them). The signal is the sum of the largest increases
-// (a 256th of the ROI's pixels, at least 9) plus the largest decreases. Around a step the ROI's
-// pixels that stepped clearly are the LED's: no light when pixels stepping the other way add up to
-// half as much (an edge moved by shake or a passing part) or when they do not hold their levels;
-// the dating sums those that do not clip when lit (all of them, marked clipped, when those
+// the frames that left the step window of the last 5 + min_on_frames, so a step is measured
+// against frames before it), each row's flicker gain taken out first (measured on the same rows
+// beside the ROI, in bands of 4 rows, interpolated: rolling-shutter banding), the ROI's outer 3 px
+// left out (shake carries what lies just outside into them). The signal is the sum of the largest
+// increases (a 256th of the ROI's pixels, at least 9) plus the largest decreases. Around a step the
+// ROI's pixels that stepped clearly are the LED's: no light when pixels stepping the other way add
+// up to half as much (an edge moved by shake or a passing part) or when they do not hold their
+// levels; the dating sums those that do not clip when lit (all of them, marked clipped, when those
 // carry less than a quarter of the step: then only the upper bound of f holds, as a clipped
 // core reaches 255 even in a partly lit frame). The fraction is known to within 3 sigmas of
 // the frame-to-frame noise (at least 0.08), widened downwards when the levels creep on after
@@ -77,7 +77,9 @@ struct LedPulse {
   /// assumption and the noise of the partial-frame fraction).
   int64_t on_uncertainty_ns = 0;
   /// First frame that saw the LED on at all (Frame::index) and the fraction of its
-  /// exposure during which it was on (1: it switched on between two exposures).
+  /// exposure during which it was on (1: it switched on between two exposures; after a
+  /// build-up, see LedResult::warnings, the level the codec showed it at, not a fraction of
+  /// the exposure).
   int64_t first_lit_frame = 0;
   double first_lit_fraction = 1.0;
   /// Frames missing between the last dark frame and a fully lit first one (by the usual
