@@ -490,6 +490,8 @@ struct LedDetector::Impl {
   // the region's window around k: a step of at least min_step, flat on both sides, whose
   // frames cross the threshold only at k; nullopt otherwise
   std::optional<WindowShape> CleanStep(int region, int64_t k, bool rise, double min_step);
+  // the event pending confirmation (described); its region takes the new level meanwhile
+  void AddPending(StepEvent event);
   // the event's signal, frames and (located) levels; false when it does not look like a light
   // (`gap` frames from k on between the levels: 1 for a step)
   bool DescribeEvent(int region, int64_t k, int gap, bool rise, const WindowShape& shape,
@@ -1017,13 +1019,7 @@ void LedDetector::Impl::TestBuildUp() {
     }
     DropRisesAfter(first);
     DescribeEvent(0, first, gap, true, *shape, contrast, event);
-    event.frames_to_confirm = kConfirmFrames;
-    event.level_before = level[0];
-    event.level_step_before = level_step[0];
-    level[0] = Level::kHigh;
-    level_step[0] = static_cast<float>(shape->step);
-    ++events_per_region[0];
-    pending.push_back(std::move(event));
+    AddPending(std::move(event));
     return;
   }
 }
@@ -1169,14 +1165,18 @@ void LedDetector::Impl::TestStep(int region, int64_t k, bool rise, double min_st
   }
   if (events_per_region[static_cast<size_t>(region)] >= kMaxEventsPerRegion) return;
 
-  // the event, pending confirmation; the region takes its new level meanwhile
   if (!DescribeEvent(region, k, 1, rise, *shape, contrast, event)) return;
+  AddPending(std::move(event));
+}
+
+void LedDetector::Impl::AddPending(StepEvent event) {
+  const auto r = static_cast<size_t>(event.region);
   event.frames_to_confirm = kConfirmFrames;
-  event.level_before = level[static_cast<size_t>(region)];
-  event.level_step_before = level_step[static_cast<size_t>(region)];
-  level[static_cast<size_t>(region)] = rise ? Level::kHigh : Level::kLow;
-  level_step[static_cast<size_t>(region)] = static_cast<float>(shape->step);
-  ++events_per_region[static_cast<size_t>(region)];
+  event.level_before = level[r];
+  event.level_step_before = level_step[r];
+  level[r] = event.rise ? Level::kHigh : Level::kLow;
+  level_step[r] = static_cast<float>(event.signal_step);
+  ++events_per_region[r];
   pending.push_back(std::move(event));
 }
 
