@@ -74,9 +74,10 @@ std::string CacheOptions(const ReportCommand& command) {
 
 // The cache file's runs: the grid, the Monte Carlo and, with --fit-ratio, the grid again at
 // each other stiffness ratio (by its Buna-N multiplier; older files have none).
+using RatioGrids = std::map<double, std::vector<fit::TensionSample>>;
 struct CachedRuns {
   std::vector<fit::TensionSample> grid, monte_carlo;
-  std::map<double, std::vector<fit::TensionSample>> ratio_grids;
+  RatioGrids ratio_grids;
 };
 
 // the cached runs, when the file is there and made with these options
@@ -121,17 +122,19 @@ Status SaveCachedRuns(const fs::path& path, const std::string& options, const Ca
 }
 
 // the grid and Monte Carlo runs, from the cache or simulated (the Monte Carlo's taken
-// from `merged` when given) and cached
-Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibration,
-                      const sim::ModelDescription& model, const sim::SweepOptions& sweep,
-                      const std::vector<fit::TensionSample>* merged, ReportCalibration& result,
-                      std::ostream& err) {
+// from `merged` when given) and cached; returns the ratio grids the cache holds (none when
+// the runs were simulated now)
+Result<RatioGrids> SimulateOrLoad(const ReportCommand& command, const Calibration& calibration,
+                                  const sim::ModelDescription& model,
+                                  const sim::SweepOptions& sweep,
+                                  const std::vector<fit::TensionSample>* merged,
+                                  ReportCalibration& result, std::ostream& err) {
   const std::string options = CacheOptions(command);
   if (auto cached = LoadCachedRuns(result.cache_path, options)) {
     result.grid = std::move(cached->grid);
     result.monte_carlo = std::move(cached->monte_carlo);
     result.from_cache = true;
-    return Status::Ok();
+    return std::move(cached->ratio_grids);
   }
   const std::vector<TensionPoint> grid =
       fit::GridTensionPoints(calibration.tension_points, command.fit);
@@ -158,7 +161,9 @@ Status SimulateOrLoad(const ReportCommand& command, const Calibration& calibrati
     err << "calibration: " << (grid.size() + draws.size()) * sweep.feet.size() << " runs in "
         << FormatFixed(wall.count(), 2) << " s wall\n";
   }
-  return SaveCachedRuns(result.cache_path, options, {result.grid, result.monte_carlo, {}});
+  LIFTOFF_RETURN_IF_ERROR(
+      SaveCachedRuns(result.cache_path, options, {result.grid, result.monte_carlo, {}}));
+  return RatioGrids{};
 }
 
 // the campaign's calibration with the fitted point among its tension points, in sigma
@@ -383,14 +388,12 @@ std::string MarkdownToHtml(const std::string& markdown) {
 namespace {
 
 // The stiffness ratio: the tension scale's grid run again at each ratio but 1 (the grid
-// itself), or taken from the cache (and cached), and the profile fitted. A ratio that cannot
-// be fitted is a result (ratio_status); a simulation that fails is an error.
+// itself), or taken from the cache's `cached` grids (and cached), and the profile fitted. A
+// ratio that cannot be fitted is a result (ratio_status); a simulation that fails is an error.
 Status FitRatio(const ReportCommand& command, const Calibration& calibration,
                 const sim::ModelDescription& model, const sim::SweepOptions& sweep,
-                ReportCalibration& result, std::ostream& err) {
-  const std::string options = CacheOptions(command);
-  CachedRuns cache = LoadCachedRuns(result.cache_path, options)
-                         .value_or(CachedRuns{result.grid, result.monte_carlo, {}});
+                RatioGrids cached, ReportCalibration& result, std::ostream& err) {
+  CachedRuns cache{result.grid, result.monte_carlo, std::move(cached)};
   std::vector<double> missing;
   for (double ratio : command.ratio.ratios) {
     if (ratio != 1.0 && !cache.ratio_grids.count(ratio)) missing.push_back(ratio);
@@ -412,7 +415,7 @@ Status FitRatio(const ReportCommand& command, const Calibration& calibration,
       const std::chrono::duration<double> wall = std::chrono::steady_clock::now() - start;
       err << "calibration: stiffness ratios in " << FormatFixed(wall.count(), 2) << " s wall\n";
     }
-    LIFTOFF_RETURN_IF_ERROR(SaveCachedRuns(result.cache_path, options, cache));
+    LIFTOFF_RETURN_IF_ERROR(SaveCachedRuns(result.cache_path, CacheOptions(command), cache));
     result.ratio_grids_run = static_cast<int>(missing.size());
   }
   std::vector<std::vector<fit::TensionSample>> grids;
@@ -449,7 +452,8 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
   LIFTOFF_ASSIGN_OR_RETURN(const sim::ModelDescription model,
                            sim::LoadModelDescription(ModelPathFrom(command.sweep.experiment)));
   LIFTOFF_ASSIGN_OR_RETURN(const sim::SweepOptions sweep, SweepOptionsFrom(command.sweep));
-  LIFTOFF_RETURN_IF_ERROR(
+  LIFTOFF_ASSIGN_OR_RETURN(
+      RatioGrids cached_ratio_grids,
       SimulateOrLoad(command, calibration, model, sweep, monte_carlo, result, err));
   result.distributions = fit::Distributions(result.monte_carlo);
 
@@ -485,7 +489,8 @@ Result<ReportCalibration> CalibrateCampaign(const ReportCommand& command,
   result.at_fit = at_fit.front();
   result.fitted = FittedCalibration(calibration, *result.fit, command.manifest_path.string());
   if (command.fit_ratio) {
-    LIFTOFF_RETURN_IF_ERROR(FitRatio(command, calibration, model, sweep, result, err));
+    LIFTOFF_RETURN_IF_ERROR(
+        FitRatio(command, calibration, model, sweep, std::move(cached_ratio_grids), result, err));
   }
   return result;
 }

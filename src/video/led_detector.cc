@@ -461,6 +461,11 @@ struct LedDetector::Impl {
   // is tested as a step is (it stands out, looks like a light, enough contrast, then holds)
   // and replaces the steps still being confirmed that began after its second frame.
   void TestBuildUp();
+  // the shape of `region`'s sums over the window of a step at k (a build-up of `gap` frames
+  // from k; 1 for a step; the window in window_values) when it steps by min_step or more and
+  // is flat before and after; nullopt otherwise
+  std::optional<WindowShape> FlatShape(int region, int64_t k, int gap, bool rise,
+                                       double threshold_frac, double min_step);
   // the signal's shape for a build-up of `gap` frames from `first`, when it is one
   std::optional<WindowShape> BuildUpShape(int64_t first, int gap, double min_step);
   // whether a rise of `step` may start at `first`: the ROI is not at a high level, or only
@@ -1024,23 +1029,32 @@ void LedDetector::Impl::TestBuildUp() {
   }
 }
 
-std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int gap,
-                                                           double min_step) {
+std::optional<WindowShape> LedDetector::Impl::FlatShape(int region, int64_t k, int gap, bool rise,
+                                                        double threshold_frac, double min_step) {
   const auto count = static_cast<size_t>(kBeforeFrames + gap + after_frames);
   for (size_t i = 0; i < count; ++i) {
-    window_values[i] = region_sums[RegionSlot(0, first - kBeforeFrames + static_cast<int64_t>(i))];
+    window_values[i] = region_sums[RegionSlot(region, k - kBeforeFrames + static_cast<int64_t>(i))];
   }
-  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, gap, after_frames, true,
-                                    kLitFraction, window_copy);
+  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, gap, after_frames, rise,
+                                    threshold_frac, window_copy);
   const double step = shape.step;
-  if (step < min_step || step <= kNoiseFactor * static_cast<double>(region_noise[0])) {
-    return std::nullopt;
-  }
+  if (step < min_step) return std::nullopt;
   const double flat = FlatFrac();
   if (shape.before_spread > flat * step || shape.after_against > flat * step ||
       shape.after_creep > kCreepFrac * step) {
     return std::nullopt;
   }
+  return shape;
+}
+
+std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int gap,
+                                                           double min_step) {
+  const std::optional<WindowShape> flat_shape =
+      FlatShape(0, first, gap, true, kLitFraction, min_step);
+  if (!flat_shape) return std::nullopt;
+  const WindowShape& shape = *flat_shape;
+  const double step = shape.step;
+  if (step <= kNoiseFactor * static_cast<double>(region_noise[0])) return std::nullopt;
   const auto fraction = [&](size_t i) { return (window_values[i] - shape.before_level) / step; };
   const auto before = static_cast<size_t>(kBeforeFrames);
   if (fraction(before - 1) >= kLitFraction) return std::nullopt;
@@ -1107,25 +1121,18 @@ double LedDetector::Impl::Contrast(int region, int64_t k, bool rise) {
 
 std::optional<WindowShape> LedDetector::Impl::CleanStep(int region, int64_t k, bool rise,
                                                         double min_step) {
-  const auto count = static_cast<size_t>(window);
-  for (size_t i = 0; i < count; ++i) {
-    window_values[i] = region_sums[RegionSlot(region, k - kBeforeFrames + static_cast<int64_t>(i))];
-  }
+  const std::optional<WindowShape> flat_shape =
+      FlatShape(region, k, 1, rise, options.threshold_frac, min_step);
+  if (!flat_shape) return std::nullopt;
+  const WindowShape& shape = *flat_shape;
+  const double step = shape.step;
+  const double flat = FlatFrac();
   const auto before = window_values.cbegin();
   const auto before_end = before + kBeforeFrames;
   const auto after = before_end + 1;
-  const auto after_end = before + static_cast<std::ptrdiff_t>(count);
+  const auto after_end = before + window;
   const auto [before_low, before_high] = std::minmax_element(before, before_end);
   const auto [after_low, after_high] = std::minmax_element(after, after_end);
-  const WindowShape shape = ShapeOf(window_values.data(), kBeforeFrames, 1, after_frames, rise,
-                                    options.threshold_frac, window_copy);
-  const double step = shape.step;
-  if (step < min_step) return std::nullopt;
-  const double flat = FlatFrac();
-  if (shape.before_spread > flat * step || shape.after_against > flat * step ||
-      shape.after_creep > kCreepFrac * step) {
-    return std::nullopt;
-  }
   // a partly lit frame just after a k still at the old level is the next frame's
   // transition: wait for it (after a partly lit k it is a codec building up a small spot
   // over a few frames)
