@@ -121,9 +121,29 @@ struct Effects {
                    (omega * (t1 - t0));
   }
 
+  // the lamp's brightness per row times the gain: the exposure of row r starts r / rows of
+  // the readout after the first row's (centred on pts), CV_32FC1 rows x 1
+  cv::Mat RowGains(int rows, double pts_s) const {
+    cv::Mat gains(rows, 1, CV_32FC1);
+    for (int r = 0; r < rows; ++r) {
+      const double offset_s = spec.flicker_readout_s * ((r + 0.5) / rows - 0.5);
+      gains.at<float>(r) = static_cast<float>(FlickerGain(pts_s + offset_s) * spec.gain);
+    }
+    return gains;
+  }
+
   cv::Mat Apply(const cv::Mat& linear, size_t frame, double pts_s) {
     // linear: CV_32FC3, 8-bit scale
-    cv::Mat image = linear * (FlickerGain(pts_s) * spec.gain);  // a new matrix: linear is kept
+    cv::Mat image;  // a new matrix: linear is kept
+    if (spec.flicker_readout_s > 0 && spec.flicker_amplitude > 0) {
+      const cv::Mat gains = RowGains(linear.rows, pts_s);
+      image.create(linear.size(), linear.type());
+      for (int r = 0; r < image.rows; ++r) {
+        image.row(r) = linear.row(r) * static_cast<double>(gains.at<float>(r));
+      }
+    } else {
+      image = linear * (FlickerGain(pts_s) * spec.gain);
+    }
     const cv::Point2d offset = ShakeAt(frame);
     if (offset.x != 0 || offset.y != 0) {
       const cv::Matx23d move(1, 0, offset.x, 0, 1, offset.y);
@@ -245,6 +265,8 @@ Status Trial3dSpec::Validate() const {
     return OutOfRange(id, "flicker_amplitude", flicker_amplitude, 0, 0.5);
   if (flicker_hz != 100 && flicker_hz != 120)
     return OutOfRange(id, "flicker_hz (100 or 120)", flicker_hz, 100, 120);
+  if (!(flicker_readout_s >= 0 && flicker_readout_s <= 1 / fps))
+    return OutOfRange(id, "flicker_readout_s", flicker_readout_s, 0, 1 / fps);
   if (!(shake_px >= 0 && shake_px <= 2)) return OutOfRange(id, "shake_px", shake_px, 0, 2);
   if (!(blur_sigma_px >= 0 && blur_sigma_px <= 5))
     return OutOfRange(id, "blur_sigma_px", blur_sigma_px, 0, 5);
@@ -560,6 +582,7 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
       {"gain", spec.gain},
       {"flicker_amplitude", spec.flicker_amplitude},
       {"flicker_hz", spec.flicker_hz},
+      {"flicker_readout_s", spec.flicker_readout_s},
       {"shake_px", spec.shake_px},
       {"blur_sigma_px", spec.blur_sigma_px},
       {"motion_blur_samples", spec.motion_blur_samples},
@@ -890,6 +913,15 @@ std::vector<Trial3dSpec> Hard3dSet() {
     s.quality = 8;
     s.shake_px = 0.6;
     s.foot = Foot::kB;
+  }
+  {
+    Trial3dSpec& s = add("hard3d-09-side-480p-rolling-flicker", 409);
+    s.flicker_amplitude = 0.3;
+    s.flicker_hz = 100;
+    s.flicker_readout_s = 1.0 / 40;  // a rolling shutter: 2.5 bands that roll every frame
+    s.exposure_s = 1.0 / 250;
+    s.noise_sigma = 2;
+    s.foot = Foot::kD;
   }
   return set;
 }

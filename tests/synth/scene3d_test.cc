@@ -242,6 +242,63 @@ TEST(Trial3d, PartialLedFrameMatchesTheTruthsFraction) {
   EXPECT_NEAR((partial - off) / (on - off), fraction, 0.5 * led.area() / (on - off) + 0.002);
 }
 
+// Frame `index` of a lossless clip, decoded.
+cv::Mat DecodedFrame(const std::filesystem::path& video, int index) {
+  cv::VideoCapture capture(video.string());
+  cv::Mat frame;
+  for (int i = 0; i <= index && capture.read(frame); ++i) {
+  }
+  return frame;
+}
+
+// A rolling shutter's readout turns the lamp's flicker into bands: against a steady lamp,
+// each row of a frame is scaled by the lamp's mean over that row's exposure, which starts
+// r / rows of the readout after the first row's; without a readout every row by the same.
+TEST(Trial3d, ARollingShuttersReadoutTurnsFlickerIntoBands) {
+  REQUIRE_EGL();
+  Trial3dSpec steady = ShortSpec();
+  steady.led_on_s = 0.5;  // frame 7 dark: the scene alone
+  steady.max_duration_s = 0.6;
+  steady.blur_sigma_px = 0;
+  Trial3dSpec banded = steady;
+  banded.flicker_amplitude = 0.3;
+  banded.flicker_hz = 100;
+  banded.exposure_s = steady.exposure_s = 1.0 / 250;
+  banded.flicker_readout_s = 1.0 / 40;
+  Trial3dSpec global = banded;
+  global.flicker_readout_s = 0;
+  testing::ScratchDir a, b, c;
+  auto s = WriteTrial3d(steady, Calibration2018(), a.path());
+  auto r = WriteTrial3d(banded, Calibration2018(), b.path());
+  auto g = WriteTrial3d(global, Calibration2018(), c.path());
+  ASSERT_TRUE(s.ok() && r.ok() && g.ok()) << r.status().ToString();
+  constexpr int kFrame = 7;
+  const double pts = ReadJson(r->truth_path)["pts"][kFrame].get<double>();
+  const cv::Mat lit = DecodedFrame(s->video_path, kFrame);
+  ASSERT_FALSE(lit.empty());
+  // the lamp's mean over [t - e/2, t + e/2]
+  const auto lamp = [&](double t) {
+    const double w = 2 * kPi * banded.flicker_hz, t0 = t - banded.exposure_s / 2,
+                 t1 = t + banded.exposure_s / 2;
+    return 1 + banded.flicker_amplitude * (std::cos(w * t0) - std::cos(w * t1)) / (w * (t1 - t0));
+  };
+  const auto ratio = [&](const cv::Mat& frame, int row) {
+    return cv::sum(frame.row(row))[1] / cv::sum(lit.row(row))[1];
+  };
+  const cv::Mat rolled = DecodedFrame(r->video_path, kFrame);
+  const cv::Mat whole = DecodedFrame(g->video_path, kFrame);
+  double lowest = 10, highest = 0;
+  for (int row = 0; row < lit.rows; row += 8) {
+    if (cv::sum(lit.row(row))[1] < 20.0 * lit.cols) continue;  // too dark to compare
+    const double offset_s = banded.flicker_readout_s * ((row + 0.5) / lit.rows - 0.5);
+    EXPECT_NEAR(ratio(rolled, row), lamp(pts + offset_s), 0.02) << "row " << row;
+    EXPECT_NEAR(ratio(whole, row), lamp(pts), 0.02) << "row " << row;
+    lowest = std::min(lowest, ratio(rolled, row));
+    highest = std::max(highest, ratio(rolled, row));
+  }
+  EXPECT_GT(highest - lowest, 0.3);  // bands: the frame's rows from dim to bright
+}
+
 // truth.json holds every field of the development set's format, consistent with itself,
 // and controller.csv is quantised as the format says.
 TEST(Trial3d, TruthAndControllerLogFollowTheFormat) {

@@ -27,9 +27,11 @@
 // > 1, the average of the poses at the midpoints of the exposure's equal parts). The LED's lit
 // fraction is the part of that exposure after the switch-on; a partially lit frame is off + f (on -
 // off) of the two rendered pictures (glow included), so it is exact. Then, in this order: flicker
-// (the lamp's 1 + a sin(2 pi f t) averaged over the exposure) times gain, camera shake (a reflected
-// random walk, +-4 px, bilinear), Gaussian blur, Gaussian sensor noise (per-pixel, seeded by (seed,
-// frame)), then the encoder.
+// (the lamp's 1 + a sin(2 pi f t) averaged over the exposure; with a rolling shutter's readout,
+// over each row's exposure, row r's starting r / rows of the readout later: bands that roll from
+// frame to frame, while the picture itself stays the global shutter's) times gain, camera shake (a
+// reflected random walk, +-4 px, bilinear), Gaussian blur, Gaussian sensor noise (per-pixel, seeded
+// by (seed, frame)), then the encoder.
 //
 // Everything is a pure function of the spec: the same spec gives the same truth and log
 // bytes, and on one machine the same pixels.
@@ -106,12 +108,15 @@ struct Trial3dSpec {
 
   /// Image effects, off at their defaults except a lens's softness: sensor noise (8-bit
   /// levels, 0 .. 30), gain (0.2 .. 4), flicker amplitude (0 .. 0.5) at flicker_hz (100
-  /// or 120), shake step per frame (px, 0 .. 2), Gaussian blur sigma (px, 0 .. 5; the
-  /// default 0.6 px stands in for anti-aliasing and optics).
+  /// or 120) seen through a readout of flicker_readout_s (0: a global shutter, the whole
+  /// frame one level; up to 1/fps: a rolling shutter's bands across the rows), shake step
+  /// per frame (px, 0 .. 2), Gaussian blur sigma (px, 0 .. 5; the default 0.6 px stands in
+  /// for anti-aliasing and optics).
   double noise_sigma = 0.0;
   double gain = 1.0;
   double flicker_amplitude = 0.0;
   double flicker_hz = 100.0;
+  double flicker_readout_s = 0.0;
   double shake_px = 0.0;
   double blur_sigma_px = 0.6;
   /// Motion blur: the scene is averaged over this many poses at the midpoints of the
@@ -190,9 +195,10 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
 /// never lifts). docs/synth.md.
 std::vector<Trial3dSpec> Ci3dSet();
 
-/// A harder 3D set for development, not rendered in CI (about 5 min): strong flicker with a
+/// A harder 3D set for development, not rendered in CI (about 6 min): strong flicker with a
 /// short exposure, low light with shake, frames dropped at the LED, a small and a large
-/// robot in frame, a tiny LED, a glossy floor in low light, MJPEG with shake. docs/synth.md.
+/// robot in frame, a tiny LED, a glossy floor in low light, MJPEG with shake, a rolling
+/// shutter's flicker bands. docs/synth.md.
 std::vector<Trial3dSpec> Hard3dSet();
 
 /// The 3D set of that name ("ci3d" or "hard3d"); kInvalidArgument for another.
