@@ -212,6 +212,15 @@ WindowShape ShapeOf(const double* values, int before_count, int gap, int after_c
   return shape;
 }
 
+// How far a window's levels are from flat, against the limits a light's pixels must keep
+// (kFlatFracPixels of the step either side, kCreepFrac after it): under 1 passes.
+double Roughness(const WindowShape& shape) {
+  if (!(shape.step > 0)) return std::numeric_limits<double>::infinity();
+  return std::max(std::max(shape.before_spread, shape.after_against) / kFlatFracPixels,
+                  shape.after_creep / kCreepFrac) /
+         shape.step;
+}
+
 enum class Level : uint8_t { kUnknown, kLow, kHigh };
 
 // One step a region made, with what is needed to date it: the frames around it.
@@ -342,7 +351,7 @@ struct LedDetector::Impl {
   std::vector<float> strip_ring;       // ring x ROI rows x strip columns
   std::vector<float> corrected;  // ROI pixels x ring
   std::vector<double> pixel_steps, channel_steps, lit_peaks, pixel_wobble;
-  std::vector<double> dating_series;
+  std::vector<double> dating_series, scaled_series;
   // with an ROI: every frame's time and the ROI's mean brightness (the trace in LedResult)
   double roi_mean_levels = 0.0;
   std::vector<int64_t> trace_t_ns;
@@ -437,6 +446,11 @@ struct LedDetector::Impl {
   // Each ROI pixel's step at frame k (pixel_steps, channel_steps, lit_peaks, pixel_wobble;
   // its gain-corrected series in `corrected`); the sums of the pixels' off and on levels.
   void MeasurePixelSteps(int64_t k, int gap, bool rise, double& off_sum, double& on_sum);
+  // The dating series (dating_series) over the frames [k - kBeforeFrames, + count): the sum of
+  // the pixels that stepped beyond `clear` (those that clip when lit only when `clipped`),
+  // each with the scene's flicker taken out; and the same pixels divided by their row's
+  // flicker gain (scaled_series): a light the flicker scales with the scene.
+  void SumDatingSeries(int64_t k, size_t count, double clear, bool clipped);
   // the quantile q of |pixel_steps| over the ROI's inner pixels
   double InnerQuantile(double q);
 
@@ -582,6 +596,7 @@ Status LedDetector::Impl::Setup(const Frame& frame) {
     lit_peaks.assign(pixels, 0.0);
     pixel_wobble.assign(pixels, 0.0);
     dating_series.assign(static_cast<size_t>(ring), 0.0);
+    scaled_series.assign(static_cast<size_t>(ring), 0.0);
     row_gains.assign(static_cast<size_t>(ring) * static_cast<size_t>(roi.height), 1.0f);
     for (int x = 0; x < width_px; x += kStripStepPx) {
       if (x < roi.x - kStripStepPx || x >= roi.x + roi.width + kStripStepPx) {
@@ -851,9 +866,26 @@ void LedDetector::Impl::MeasurePixelSteps(int64_t k, int gap, bool rise, double&
   }
 }
 
+void LedDetector::Impl::SumDatingSeries(int64_t k, size_t count, double clear, bool clipped) {
+  const auto frames_in_ring = static_cast<size_t>(ring);
+  const auto width = static_cast<size_t>(options.roi_px.width);
+  std::fill(dating_series.begin(), dating_series.end(), 0.0);
+  std::fill(scaled_series.begin(), scaled_series.end(), 0.0);
+  for (size_t i = 0; i < pixel_reference.size(); ++i) {
+    if (!(pixel_steps[i] > clear) || (!clipped && lit_peaks[i] >= kClipLevels)) continue;
+    const float* values = &corrected[i * frames_in_ring];
+    for (size_t j = 0; j < count; ++j) {
+      const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
+      const uint8_t* pixel = RoiPicture(slot) + 3 * i;
+      dating_series[j] += static_cast<double>(values[j]);
+      scaled_series[j] +=
+          (pixel[0] + pixel[1] + pixel[2]) / static_cast<double>(RowGains(slot)[i / width]);
+    }
+  }
+}
+
 bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent& event) {
   const size_t pixels = pixel_reference.size();
-  const auto frames_in_ring = static_cast<size_t>(ring);
   const auto count = static_cast<size_t>(kBeforeFrames + gap + after_frames);
   const auto width = static_cast<size_t>(options.roi_px.width);
   double off_sum = 0.0, on_sum = 0.0;
@@ -879,23 +911,27 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent&
   }
   event.clipped = unclipped < kUnclippedShare * stepped;
   event.standout = largest / std::max(kStandoutFloor, InnerQuantile(kOutlierQuantile));
-  // the dating dating_series and the LED's contrast over the chosen pixels
-  std::fill(dating_series.begin(), dating_series.end(), 0.0);
+  // the dating series and the LED's contrast over the chosen pixels
   std::vector<double> contrasts;
   for (size_t i = 0; i < pixels; ++i) {
-    if (!(pixel_steps[i] > clear)) continue;
-    contrasts.push_back(channel_steps[i]);
-    if (!event.clipped && lit_peaks[i] >= kClipLevels) continue;
-    const float* values = &corrected[i * frames_in_ring];
-    for (size_t j = 0; j < count; ++j) dating_series[j] += static_cast<double>(values[j]);
+    if (pixel_steps[i] > clear) contrasts.push_back(channel_steps[i]);
   }
   std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
   event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
+  SumDatingSeries(k, count, clear, event.clipped);
   // the levels: the medians of the frames before and after (the pixels of a small light
-  // may still be catching up after it: the creep widens the partly lit frame's band)
-  const WindowShape shape =
-      ShapeOf(dating_series.data(), kBeforeFrames, gap, after_frames, rise,
-              std::max(options.threshold_frac, kPartlyLitBeforeFrac), window_copy);
+  // may still be catching up after it: the creep widens the partly lit frame's band); the
+  // series whose lit frames hold flatter: the LED's own light, or all of it scaled by the
+  // flicker (a renderer's flicker scales the whole picture)
+  const double threshold_frac = std::max(options.threshold_frac, kPartlyLitBeforeFrac);
+  WindowShape shape = ShapeOf(dating_series.data(), kBeforeFrames, gap, after_frames, rise,
+                              threshold_frac, window_copy);
+  const WindowShape scaled = ShapeOf(scaled_series.data(), kBeforeFrames, gap, after_frames, rise,
+                                     threshold_frac, window_copy);
+  if (scaled.step > 0 && Roughness(scaled) < Roughness(shape)) {
+    shape = scaled;
+    dating_series.swap(scaled_series);
+  }
   if (!(shape.step > 0)) return false;
   const double widest = std::max(shape.before_spread, shape.after_against);
   if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {

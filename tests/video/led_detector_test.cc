@@ -224,7 +224,12 @@ struct TinyLedStream {
   // and brighten_after_frames later the LED's light brighten_factor times as strong (the
   // codec refining its spot).
   bool flicker = true;
+  // The flicker's amplitude, and whether it scales the LED's light with the picture (a
+  // renderer's flicker applied to the whole image) or only the wall (a lamp's).
+  double flicker_amplitude = 0.08;
+  bool flicker_scales_led = false;
   double light_scale = 1.0;
+  double wall_scale = 1.0;  // the wall's brightness (90 .. 200 levels) times this
   double refresh_levels = 0.0;
   int brighten_after_frames = 0;
   double brighten_factor = 1.0;
@@ -242,6 +247,7 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
   cv::RNG rng(777);
   rng.fill(wall, cv::RNG::UNIFORM, cv::Scalar::all(90), cv::Scalar::all(200));
   cv::GaussianBlur(wall, wall, cv::Size(0, 0), 2.0);
+  wall *= stream.wall_scale;
   // the LED's light when fully lit (B, G, R): a core far beyond the sensor's range on its
   // centre pixel, half of it on the four neighbours, and a glow of sigma 1.2 px
   cv::Mat light(size, CV_32FC3, cv::Scalar::all(0));
@@ -269,10 +275,12 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
     }
     cv::Mat picture = wall.clone();
     const double phase = 0.37 * index;
-    for (int y = 0; y < size.height; ++y) {
-      const double gain = stream.flicker ? 1.0 + 0.08 * std::sin(2 * CV_PI * (y / 90.0 + phase)) : 1.0;
-      picture.row(y) *= gain;
-    }
+    const auto scale_rows = [&](cv::Mat& image) {
+      for (int y = 0; y < size.height && stream.flicker; ++y) {
+        image.row(y) *= 1.0 + stream.flicker_amplitude * std::sin(2 * CV_PI * (y / 90.0 + phase));
+      }
+    };
+    if (!stream.flicker_scales_led) scale_rows(picture);
     const double on_frames = stream.on_s ? t_s * stream.fps - *stream.on_s * stream.fps : -1.0;
     const bool refined = stream.brighten_after_frames > 0 && on_frames >= stream.brighten_after_frames;
     // (the how-manieth lit frame this is, 1 for the first)
@@ -282,6 +290,7 @@ std::vector<Frame> DrawTinyLedStream(const TinyLedStream& stream) {
                              ? stream.build_up[static_cast<size_t>(lit_frames) - 1]
                              : 1.0;
     picture += lit * shown * stream.light_scale * (refined ? stream.brighten_factor : 1.0) * light;
+    if (stream.flicker_scales_led) scale_rows(picture);
     if (lit > 0 && stream.refresh_levels > 0) {
       cv::Mat pattern(size, CV_32FC3);
       cv::RNG(555).fill(pattern, cv::RNG::UNIFORM, cv::Scalar::all(-stream.refresh_levels),
@@ -368,6 +377,23 @@ TEST(LedDetector, FindsATinySaturatingLedInABigFlickeringNoisyRegion) {
   ASSERT_TRUE(result);
   EXPECT_GE(result->contrast_levels, 100.0);
   EXPECT_FALSE(SaysBuiltUp(*result)) << result->Brief();
+}
+
+// A renderer's flicker scales the whole picture, the LED's light too: rolling bands of
+// +-30 % make the LED's lit frames swing as much, but its light over its row's gain holds,
+// and measures how much of frame 45's exposure was lit (60 %) on its partly lit frame.
+TEST(LedDetector, ALedTheFlickerScalesWithThePictureIsDatedByItsLightOverTheGain) {
+  TinyLedStream stream;
+  stream.flicker_amplitude = 0.25;
+  stream.flicker_scales_led = true;
+  stream.wall_scale = 0.5;  // nothing clips, not even at the flicker's brightest
+  stream.light_scale = 0.4;
+  stream.noise_sigma = 1.0;
+  stream.on_s = 1.5 - 0.5 * stream.exposure_s + 0.4 * stream.exposure_s;
+  const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
+  ASSERT_TRUE(result);
+  EXPECT_NEAR(result->pulses[0].first_lit_fraction, 0.6, 0.05) << result->Brief();
+  EXPECT_LE(result->pulses[0].on_uncertainty_ns, 0.25 * stream.PeriodNs()) << result->Brief();
 }
 
 // A codec that renews the LED's block when the LED lights moves every pixel of that block
