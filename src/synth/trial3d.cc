@@ -121,29 +121,19 @@ struct Effects {
                    (omega * (t1 - t0));
   }
 
-  // the lamp's brightness per row times the gain: the exposure of row r starts r / rows of
-  // the readout after the first row's (centred on pts), CV_32FC1 rows x 1
-  cv::Mat RowGains(int rows, double pts_s) const {
-    cv::Mat gains(rows, 1, CV_32FC1);
-    for (int r = 0; r < rows; ++r) {
-      const double offset_s = spec.flicker_readout_s * ((r + 0.5) / rows - 0.5);
-      gains.at<float>(r) = static_cast<float>(FlickerGain(pts_s + offset_s) * spec.gain);
+  // a rolling shutter's readout: each sensor row sees the lamp's mean over its own exposure,
+  // which starts r / rows of the readout after the first row's (centred on pts); in place
+  void ScaleRows(cv::Mat& image, double pts_s) const {
+    for (int r = 0; r < image.rows; ++r) {
+      const double offset_s = spec.flicker_readout_s * ((r + 0.5) / image.rows - 0.5);
+      image.row(r) *= FlickerGain(pts_s + offset_s);
     }
-    return gains;
   }
 
   cv::Mat Apply(const cv::Mat& linear, size_t frame, double pts_s) {
     // linear: CV_32FC3, 8-bit scale
-    cv::Mat image;  // a new matrix: linear is kept
-    if (spec.flicker_readout_s > 0 && spec.flicker_amplitude > 0) {
-      const cv::Mat gains = RowGains(linear.rows, pts_s);
-      image.create(linear.size(), linear.type());
-      for (int r = 0; r < image.rows; ++r) {
-        image.row(r) = linear.row(r) * static_cast<double>(gains.at<float>(r));
-      }
-    } else {
-      image = linear * (FlickerGain(pts_s) * spec.gain);
-    }
+    const bool rolling = spec.flicker_readout_s > 0 && spec.flicker_amplitude > 0;
+    cv::Mat image = linear * ((rolling ? 1.0 : FlickerGain(pts_s)) * spec.gain);  // a new matrix
     const cv::Point2d offset = ShakeAt(frame);
     if (offset.x != 0 || offset.y != 0) {
       const cv::Matx23d move(1, 0, offset.x, 0, 1, offset.y);
@@ -151,6 +141,7 @@ struct Effects {
       cv::warpAffine(image, moved, move, image.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
       image = moved;
     }
+    if (rolling) ScaleRows(image, pts_s);  // the bands stay on the sensor's rows
     if (spec.blur_sigma_px > 0) cv::GaussianBlur(image, image, cv::Size(0, 0), spec.blur_sigma_px);
     if (spec.noise_sigma > 0) {
       cv::RNG rng(spec.seed ^ kNoiseStream ^ (0x9E3779B97F4A7C15ull * (frame + 1)));

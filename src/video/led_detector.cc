@@ -114,6 +114,8 @@ constexpr double kRowRatioMax = 1.6;
 // least kStripMinSamples samples a row.
 constexpr int kStripStepPx = 16;
 constexpr size_t kStripMinSamples = 8;
+// A row gain under this (a black frame) is not divided by.
+constexpr double kMinRowGain = 0.05;
 // Rows share their flicker gain in bands of this many.
 constexpr int kGainBandRows = 4;
 // A lit pixel whose brightest channel reaches this level clips (a codec's rounding keeps a
@@ -450,7 +452,8 @@ struct LedDetector::Impl {
   // the pixels that stepped beyond `clear` (those that clip when lit only when `clipped`),
   // each with the scene's flicker taken out; and the same pixels divided by their row's
   // flicker gain (scaled_series): a light the flicker scales with the scene.
-  void SumDatingSeries(int64_t k, size_t count, double clear, bool clipped);
+  // False (scaled_series left at 0) where a row's gain is under kMinRowGain (a black frame).
+  bool SumDatingSeries(int64_t k, size_t count, double clear, bool clipped);
   // the quantile q of |pixel_steps| over the ROI's inner pixels
   double InnerQuantile(double q);
 
@@ -866,22 +869,26 @@ void LedDetector::Impl::MeasurePixelSteps(int64_t k, int gap, bool rise, double&
   }
 }
 
-void LedDetector::Impl::SumDatingSeries(int64_t k, size_t count, double clear, bool clipped) {
+bool LedDetector::Impl::SumDatingSeries(int64_t k, size_t count, double clear, bool clipped) {
   const auto frames_in_ring = static_cast<size_t>(ring);
   const auto width = static_cast<size_t>(options.roi_px.width);
   std::fill(dating_series.begin(), dating_series.end(), 0.0);
   std::fill(scaled_series.begin(), scaled_series.end(), 0.0);
+  bool scaled = true;
   for (size_t i = 0; i < pixel_reference.size(); ++i) {
     if (!(pixel_steps[i] > clear) || (!clipped && lit_peaks[i] >= kClipLevels)) continue;
     const float* values = &corrected[i * frames_in_ring];
     for (size_t j = 0; j < count; ++j) {
       const size_t slot = Slot(k - kBeforeFrames + static_cast<int64_t>(j));
       const uint8_t* pixel = RoiPicture(slot) + 3 * i;
+      const double gain = static_cast<double>(RowGains(slot)[i / width]);
       dating_series[j] += static_cast<double>(values[j]);
-      scaled_series[j] +=
-          (pixel[0] + pixel[1] + pixel[2]) / static_cast<double>(RowGains(slot)[i / width]);
+      scaled = scaled && gain >= kMinRowGain;
+      if (scaled) scaled_series[j] += (pixel[0] + pixel[1] + pixel[2]) / gain;
     }
   }
+  if (!scaled) std::fill(scaled_series.begin(), scaled_series.end(), 0.0);
+  return scaled;
 }
 
 bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent& event) {
@@ -918,7 +925,7 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent&
   }
   std::sort(contrasts.begin(), contrasts.end(), std::greater<>());
   event.contrast_levels = contrasts[std::min(contrasts.size() - 1, kContrastRank)];
-  SumDatingSeries(k, count, clear, event.clipped);
+  const bool scaled_usable = SumDatingSeries(k, count, clear, event.clipped);
   // the levels: the medians of the frames before and after (the pixels of a small light
   // may still be catching up after it: the creep widens the partly lit frame's band); the
   // series whose lit frames hold flatter: the LED's own light, or all of it scaled by the
@@ -928,15 +935,12 @@ bool LedDetector::Impl::MeasureRoiStep(int64_t k, int gap, bool rise, StepEvent&
                               threshold_frac, window_copy);
   const WindowShape scaled = ShapeOf(scaled_series.data(), kBeforeFrames, gap, after_frames, rise,
                                      threshold_frac, window_copy);
-  if (scaled.step > 0 && Roughness(scaled) < Roughness(shape)) {
+  if (scaled_usable && Roughness(scaled) < Roughness(shape)) {
     shape = scaled;
     dating_series.swap(scaled_series);
   }
-  if (!(shape.step > 0)) return false;
+  if (!(shape.step > 0) || Roughness(shape) > 1.0) return false;
   const double widest = std::max(shape.before_spread, shape.after_against);
-  if (widest > kFlatFracPixels * shape.step || shape.after_creep > kCreepFrac * shape.step) {
-    return false;
-  }
   event.off = rise ? shape.before_level : shape.after_level;
   event.on = rise ? shape.after_level : shape.before_level;
   if (!(event.on > event.off)) return false;

@@ -257,7 +257,7 @@ cv::Mat DecodedFrame(const std::filesystem::path& video, int index) {
 TEST(Trial3d, ARollingShuttersReadoutTurnsFlickerIntoBands) {
   REQUIRE_EGL();
   Trial3dSpec steady = ShortSpec();
-  steady.led_on_s = 0.5;  // frame 7 dark: the scene alone
+  steady.led_on_s = 0.5;  // frames 7 and 8 dark: the scene alone
   steady.max_duration_s = 0.6;
   steady.blur_sigma_px = 0;
   Trial3dSpec banded = steady;
@@ -272,31 +272,37 @@ TEST(Trial3d, ARollingShuttersReadoutTurnsFlickerIntoBands) {
   auto r = WriteTrial3d(banded, Calibration2018(), b.path());
   auto g = WriteTrial3d(global, Calibration2018(), c.path());
   ASSERT_TRUE(s.ok() && r.ok() && g.ok()) << r.status().ToString();
-  constexpr int kFrame = 7;
-  const double pts = ReadJson(r->truth_path)["pts"][kFrame].get<double>();
-  const cv::Mat lit = DecodedFrame(s->video_path, kFrame);
-  ASSERT_FALSE(lit.empty());
   // the lamp's mean over [t - e/2, t + e/2]
   const auto lamp = [&](double t) {
     const double w = 2 * kPi * banded.flicker_hz, t0 = t - banded.exposure_s / 2,
                  t1 = t + banded.exposure_s / 2;
     return 1 + banded.flicker_amplitude * (std::cos(w * t0) - std::cos(w * t1)) / (w * (t1 - t0));
   };
-  const auto ratio = [&](const cv::Mat& frame, int row) {
-    return cv::sum(frame.row(row))[1] / cv::sum(lit.row(row))[1];
-  };
-  const cv::Mat rolled = DecodedFrame(r->video_path, kFrame);
-  const cv::Mat whole = DecodedFrame(g->video_path, kFrame);
-  double lowest = 10, highest = 0;
-  for (int row = 0; row < lit.rows; row += 8) {
-    if (cv::sum(lit.row(row))[1] < 20.0 * lit.cols) continue;  // too dark to compare
-    const double offset_s = banded.flicker_readout_s * ((row + 0.5) / lit.rows - 0.5);
-    EXPECT_NEAR(ratio(rolled, row), lamp(pts + offset_s), 0.02) << "row " << row;
-    EXPECT_NEAR(ratio(whole, row), lamp(pts), 0.02) << "row " << row;
-    lowest = std::min(lowest, ratio(rolled, row));
-    highest = std::max(highest, ratio(rolled, row));
+  // frames 7 and 8 (dark LED): each row against the steady lamp's; the bands move between them
+  std::vector<double> middle_rows;
+  for (const int frame : {7, 8}) {
+    const double pts = ReadJson(r->truth_path)["pts"][static_cast<size_t>(frame)].get<double>();
+    const cv::Mat steady_frame = DecodedFrame(s->video_path, frame);
+    ASSERT_FALSE(steady_frame.empty());
+    const auto ratio = [&](const cv::Mat& image, int row) {
+      return cv::sum(image.row(row))[1] / cv::sum(steady_frame.row(row))[1];
+    };
+    const cv::Mat rolled = DecodedFrame(r->video_path, frame);
+    const cv::Mat whole = DecodedFrame(g->video_path, frame);
+    double lowest = 10, highest = 0;
+    for (int row = 0; row < steady_frame.rows; row += 8) {
+      if (cv::sum(steady_frame.row(row))[1] < 20.0 * steady_frame.cols) continue;  // too dark
+      const double offset_s = banded.flicker_readout_s * ((row + 0.5) / steady_frame.rows - 0.5);
+      EXPECT_NEAR(ratio(rolled, row), lamp(pts + offset_s), 0.02)
+          << "frame " << frame << " row " << row;
+      EXPECT_NEAR(ratio(whole, row), lamp(pts), 0.02) << "frame " << frame << " row " << row;
+      lowest = std::min(lowest, ratio(rolled, row));
+      highest = std::max(highest, ratio(rolled, row));
+    }
+    EXPECT_GT(highest - lowest, 0.3);  // bands: the frame's rows from dim to bright
+    middle_rows.push_back(ratio(rolled, steady_frame.rows / 2));
   }
-  EXPECT_GT(highest - lowest, 0.3);  // bands: the frame's rows from dim to bright
+  EXPECT_GT(std::abs(middle_rows[1] - middle_rows[0]), 0.1);  // the bands rolled
 }
 
 // truth.json holds every field of the development set's format, consistent with itself,

@@ -27,11 +27,12 @@
 // > 1, the average of the poses at the midpoints of the exposure's equal parts). The LED's lit
 // fraction is the part of that exposure after the switch-on; a partially lit frame is off + f (on -
 // off) of the two rendered pictures (glow included), so it is exact. Then, in this order: flicker
-// (the lamp's 1 + a sin(2 pi f t) averaged over the exposure; with a rolling shutter's readout,
-// over each row's exposure, row r's starting r / rows of the readout later: bands that roll from
-// frame to frame, while the picture itself stays the global shutter's) times gain, camera shake (a
+// (the lamp's 1 + a sin(2 pi f t) averaged over the exposure) times gain, camera shake (a
 // reflected random walk, +-4 px, bilinear), Gaussian blur, Gaussian sensor noise (per-pixel, seeded
-// by (seed, frame)), then the encoder.
+// by (seed, frame)), then the encoder. With a rolling shutter's readout the flicker comes after the
+// shake instead, row by row on the sensor: row r sees the lamp over its own exposure, which starts
+// r / rows of the readout after the first row's, so the bands roll from frame to frame while the
+// picture itself stays the global shutter's.
 //
 // Everything is a pure function of the spec: the same spec gives the same truth and log
 // bytes, and on one machine the same pixels.
@@ -195,7 +196,7 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
 /// never lifts). docs/synth.md.
 std::vector<Trial3dSpec> Ci3dSet();
 
-/// A harder 3D set for development, not rendered in CI (about 6 min): strong flicker with a
+/// A harder 3D set for development, not rendered in CI (about 4 min): strong flicker with a
 /// short exposure, low light with shake, frames dropped at the LED, a small and a large
 /// robot in frame, a tiny LED, a glossy floor in low light, MJPEG with shake, a rolling
 /// shutter's flicker bands. docs/synth.md.
