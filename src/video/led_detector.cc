@@ -114,6 +114,9 @@ constexpr double kRowRatioMax = 1.6;
 // least kStripMinSamples samples a row.
 constexpr int kStripStepPx = 16;
 constexpr size_t kStripMinSamples = 8;
+// With an ROI, a row of the frame's cells changes gain between two frames by the median of
+// its cells' ratios, from at least this many cells (else the frame's gain).
+constexpr size_t kRowRatioMinCells = 3;
 // A row gain under this (a black frame) is not divided by.
 constexpr double kMinRowGain = 0.05;
 // Rows share their flicker gain in bands of this many.
@@ -462,6 +465,11 @@ struct LedDetector::Impl {
   // what a step's jump must exceed to stand out from the frame at k (with an ROI: the
   // reference cells' sharp jumps, scaled to the ROI's size)
   double OutlierJump(int64_t k);
+
+  // the median ratio of a row of cells' brightest channels, next over previous (cells
+  // darker than kGainMinLevels or clipped left out), or `fallback` from under
+  // kRowRatioMinCells cells
+  double RowRatio(const uint8_t* previous, const uint8_t* next, double fallback);
 
   // what a step's contrast must reach to stand out from the frame at k: the brightest
   // channel of most cells stays put, except where many step together
@@ -999,10 +1007,36 @@ double LedDetector::Impl::OutlierContrast(int64_t k) {
   const uint8_t* previous = &cell_peaks[Slot(k - 1) * Cells()];
   const uint8_t* next = &cell_peaks[Slot(k + 1) * Cells()];
   const double previous_gain = ring_gain[Slot(k - 1)], next_gain = ring_gain[Slot(k + 1)];
-  for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
-    jumps.push_back(std::abs(next[c] / next_gain - previous[c] / previous_gain));
+  if (located) {
+    for (size_t c = 0; c < Cells(); c += SampleStride(Cells())) {
+      jumps.push_back(std::abs(next[c] / next_gain - previous[c] / previous_gain));
+    }
+    return kOutlierFactor * OrderQuantileOf(jumps, kOutlierQuantile);
+  }
+  // with an ROI (a lattice of a few cells a row): each row of cells by its own change of
+  // gain between the two frames, as a rolling shutter bands the flicker by rows
+  const auto columns = static_cast<size_t>(grid.columns);
+  for (size_t row = 0; row < static_cast<size_t>(grid.rows); ++row) {
+    const double ratio =
+        RowRatio(previous + row * columns, next + row * columns, next_gain / previous_gain);
+    for (size_t c = row * columns; c < (row + 1) * columns; ++c) {
+      jumps.push_back(std::abs(next[c] - ratio * previous[c]) / next_gain);
+    }
   }
   return kOutlierFactor * OrderQuantileOf(jumps, kOutlierQuantile);
+}
+
+double LedDetector::Impl::RowRatio(const uint8_t* previous, const uint8_t* next, double fallback) {
+  row_ratios.clear();
+  for (int c = 0; c < grid.columns; ++c) {
+    if (previous[c] >= kGainMinLevels && next[c] >= kGainMinLevels && previous[c] < kClipLevels &&
+        next[c] < kClipLevels) {
+      row_ratios.push_back(static_cast<float>(next[c]) / static_cast<float>(previous[c]));
+    }
+  }
+  if (row_ratios.size() < kRowRatioMinCells) return fallback;
+  return static_cast<double>(
+      MedianOf(row_ratios.data(), static_cast<std::ptrdiff_t>(row_ratios.size())));
 }
 
 void LedDetector::Impl::Evaluate() {
