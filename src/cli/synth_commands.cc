@@ -103,9 +103,14 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     synth::Set3dVariation variation;
     variation.seed_offset = command.seed_offset;
     variation.rise_slowdown = command.rise_slowdown;
-    if (auto named = MessageNamingFlag(variation.Validate().message(), "--rise-slowdown",
-                                       "rise_slowdown", false)) {
-      return InvalidArgumentError(*named);
+    variation.keyframe_interval_frames = command.keyframe_interval_frames;
+    const std::string invalid = variation.Validate().message();
+    for (const auto& [flag, field] :
+         {std::pair{"--rise-slowdown", "rise_slowdown"},
+          std::pair{"--keyframe-interval", "keyframe_interval_frames"}}) {
+      if (auto named = MessageNamingFlag(invalid, flag, field, false)) {
+        return InvalidArgumentError(*named);
+      }
     }
     return synth::WriteSet3d(command.set_name, command.output_dir, calibration, progress,
                              variation);
@@ -173,8 +178,13 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   }
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
-  if (command.rise_slowdown != 1.0 && command.set_name != "ci3d" && command.set_name != "hard3d") {
+  const bool set3d = command.set_name == "ci3d" || command.set_name == "hard3d";
+  if (command.rise_slowdown != 1.0 && !set3d) {
     err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
+    return kExitUsage;
+  }
+  if (command.keyframe_interval_frames != 0 && !set3d) {
+    err << "liftoff synth: --keyframe-interval works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
   if (command.set_name == "ci3d" || command.set_name == "hard3d" ||
@@ -208,6 +218,10 @@ Subcommand AddSynthCommand(Command& parent) {
   app->AddOption("--rise-slowdown", command->rise_slowdown,
                  "--set ci3d or hard3d: every foot rises this many times slower than simulated "
                  "once off the ground (1 .. 20)")
+      ->ShowDefault();
+  app->AddOption("--keyframe-interval", command->keyframe_interval_frames,
+                 "--set ci3d or hard3d: a key frame every this many frames (0 .. 10000; 0: one "
+                 "a nominal second; a camera's H.264 often has 250)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

@@ -269,6 +269,7 @@ Status Trial3dSpec::Validate() const {
   writer.height_px = scene.height_px;
   writer.nominal_fps = fps;
   writer.quality = quality;
+  writer.keyframe_interval_frames = keyframe_interval_frames;
   return writer.Validate().WithContext("trial3d " + id);
 }
 
@@ -569,6 +570,7 @@ nlohmann::json TruthJson(const Trial3dSpec& spec, const Motion3d& motion,
       {"timestamp_jitter_s", spec.timestamp_jitter_s},
       {"drop_frames_at_led", spec.drop_frames_at_led},
       {"quality", spec.quality},
+      {"keyframe_interval_frames", spec.keyframe_interval_frames},
       {"noise_sigma", spec.noise_sigma},
       {"gain", spec.gain},
       {"flicker_amplitude", spec.flicker_amplitude},
@@ -670,6 +672,7 @@ Result<WrittenTrial3d> WriteTrial3d(const Trial3dSpec& spec, const Calibration& 
   writer_options.height_px = spec.scene.height_px;
   writer_options.nominal_fps = spec.fps;
   writer_options.quality = spec.quality;
+  writer_options.keyframe_interval_frames = spec.keyframe_interval_frames;
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<VideoWriter> video,
                            VideoWriter::Open(written.video_path, writer_options));
   LIFTOFF_ASSIGN_OR_RETURN(const Timing timing, PlanFrames(spec, motion, *video));
@@ -980,7 +983,12 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
   return summary;
 }
 
-Status Set3dVariation::Validate() const { return CheckRiseSlowdown(rise_slowdown); }
+Status Set3dVariation::Validate() const {
+  LIFTOFF_RETURN_IF_ERROR(CheckRiseSlowdown(rise_slowdown));
+  VideoWriterOptions writer;
+  writer.keyframe_interval_frames = keyframe_interval_frames;
+  return writer.Validate();
+}
 
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
                                 const Calibration& calibration, const Set3dProgress& progress,
@@ -991,6 +999,7 @@ Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::
     spec.seed += variation.seed_offset;
     spec.scene.seed += variation.seed_offset;
     spec.rise_slowdown = variation.rise_slowdown;
+    spec.keyframe_interval_frames = variation.keyframe_interval_frames;
   }
   std::string varied;
   if (variation.seed_offset != 0) {
@@ -998,6 +1007,10 @@ Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::
   }
   if (variation.rise_slowdown != 1.0) {
     varied += ", the feet rising " + FormatNumber(variation.rise_slowdown) + " times slower";
+  }
+  if (variation.keyframe_interval_frames != 0) {
+    varied +=
+        ", a key frame every " + std::to_string(variation.keyframe_interval_frames) + " frames";
   }
   const std::string description =
       varied.empty() ? "" : "liftoff synth set " + name + " (" + calibration.name + ")" + varied;

@@ -104,6 +104,8 @@ Status VideoWriterOptions::Validate() const {
   } else if (codec == VideoCodec::kMjpeg) {
     LIFTOFF_RETURN_IF_ERROR(check("quality", quality, {.min = 2, .max = 31}, " (q:v for mjpeg)"));
   }
+  LIFTOFF_RETURN_IF_ERROR(check("keyframe_interval_frames", keyframe_interval_frames,
+                                {.min = 0, .max = 10'000}, " frames (0: one a nominal second)"));
   return check("time_base_den", static_cast<double>(time_base_den),
                {.min = 10'000, .max = 1'000'000'000}, " ticks per second");
 }
@@ -202,7 +204,9 @@ struct VideoWriter::Impl {
     encoder->pix_fmt = choice.pixel_format;
     encoder->time_base = ContainerTimeBase(options);
     encoder->framerate = av_d2q(options.nominal_fps, 1'000'000);
-    encoder->gop_size = std::max(1, static_cast<int>(std::lround(options.nominal_fps)));
+    encoder->gop_size = options.keyframe_interval_frames > 0
+                            ? options.keyframe_interval_frames
+                            : std::max(1, static_cast<int>(std::lround(options.nominal_fps)));
     encoder->sample_aspect_ratio = {1, 1};
     // bit-exact: no random segment id, no version strings; the same frames give the same bytes
     format->flags |= AVFMT_FLAG_BITEXACT;

@@ -441,6 +441,9 @@ TEST(Trial3d, ASlowerRiseStretchesTheLiftAfterTheGroundContact) {
   Set3dVariation variation;
   variation.rise_slowdown = 21;
   EXPECT_NE(variation.Validate().message().find("rise_slowdown"), std::string::npos);
+  variation.rise_slowdown = 1;
+  variation.keyframe_interval_frames = -1;
+  EXPECT_NE(variation.Validate().message().find("keyframe_interval_frames"), std::string::npos);
 }
 
 TEST(Trial3d, LedFractionOfTheCentredExposure) {

@@ -13,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "liftoff/core/random.h"
+#include "liftoff/video/video_reader.h"
 #include "support/test_support.h"
 
 namespace liftoff::synth {
@@ -306,6 +307,39 @@ TEST(VideoWriter, H264ReadsBackAtTheStoredTimesExceptTheBFrameTail) {
 
 // Finds a box's four-character type in the file, or npos.
 size_t FindBox(const std::string& bytes, const char* type) { return bytes.find(type); }
+
+// Key frames (as liftoff's reader sees them) at most a nominal second apart by default, else
+// at most keyframe_interval_frames (x264 may add one at what it takes for a scene cut), the
+// first frame one.
+TEST(VideoWriter, H264KeyFramesComeAtMostTheAskedIntervalApart) {
+  ScratchDir scratch;
+  for (const int interval : {0, 7}) {
+    SCOPED_TRACE(interval);
+    VideoWriterOptions options = SmallClip(VideoCodec::kH264);
+    options.keyframe_interval_frames = interval;
+    const auto path = ClipPath(scratch, VideoCodec::kH264, "key" + std::to_string(interval));
+    WriteClip(path, options, RegularTimesNs(kFrames));
+    auto reader = video::VideoReader::Open(path);
+    ASSERT_TRUE(reader.ok()) << reader.status().ToString();
+    const int64_t every = interval > 0 ? interval : static_cast<int64_t>(kFps);
+    video::Frame frame;
+    std::vector<int64_t> keys;
+    while (reader->Next(frame).value()) {
+      if (frame.keyframe) keys.push_back(frame.index);
+    }
+    ASSERT_FALSE(keys.empty());
+    EXPECT_EQ(keys.front(), 0);
+    keys.push_back(kFrames);  // the clip's end: the last key frame's run ends there
+    for (size_t i = 1; i < keys.size(); ++i) {
+      EXPECT_LE(keys[i] - keys[i - 1], every) << "key frames at " << keys[i - 1] << ", " << keys[i];
+    }
+    // fewer than a frame in two: the interval is more than a plain encoder's default
+    EXPECT_LE(keys.size(), static_cast<size_t>(kFrames / every + 3));
+  }
+  VideoWriterOptions bad = SmallClip(VideoCodec::kH264);
+  bad.keyframe_interval_frames = 10'001;
+  EXPECT_NE(bad.Validate().message().find("keyframe_interval_frames"), std::string::npos);
+}
 
 TEST(VideoWriter, H264HasBFramesAndItsIndexUpFront) {
   ScratchDir scratch;

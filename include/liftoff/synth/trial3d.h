@@ -95,6 +95,9 @@ struct Trial3dSpec {
   VideoCodec codec = VideoCodec::kH264;
   /// CRF (h264) or q:v (mjpeg), as CameraSpec.
   int quality = 20;
+  /// Frames between key frames (VideoWriterOptions::keyframe_interval_frames; 0: one a
+  /// nominal second).
+  int keyframe_interval_frames = 0;
 
   /// The LED switch-on (and the ramp's start), video clock, s (0.2 .. 60).
   double led_on_s = 2.0;
@@ -231,6 +234,8 @@ struct Set3dVariation {
   uint64_t seed_offset = 0;
   /// Every clip's Trial3dSpec::rise_slowdown (1 .. 20).
   double rise_slowdown = 1.0;
+  /// Every clip's Trial3dSpec::keyframe_interval_frames (0 .. 10000; 0: one a second).
+  int keyframe_interval_frames = 0;
 
   Status Validate() const;
 };

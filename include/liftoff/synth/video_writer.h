@@ -41,8 +41,13 @@ struct VideoWriterOptions {
   int width_px = 640;
   int height_px = 480;
   /// Nominal frame rate, Hz (1 .. 1000): the AVI slot rate, the key-frame interval (one
-  /// key frame per nominal second) and the rate a reader reports as the file's fps.
+  /// key frame per nominal second, unless keyframe_interval_frames says otherwise) and the
+  /// rate a reader reports as the file's fps.
   double nominal_fps = 60.0;
+  /// Most frames from one key frame to the next, 0 .. 10000 (0: a nominal second; x264 may
+  /// add a key frame at what it takes for a scene cut). A long interval lets H.264 hold slow
+  /// motion back longer, as a camera's 250 frames do.
+  int keyframe_interval_frames = 0;
   /// CRF for h264 (0 .. 51, lower is better), q:v for mjpeg (2 .. 31, lower is better);
   /// ffv1 ignores it.
   int quality = 20;
