@@ -90,12 +90,14 @@ double Evaluate(const Coefficients& c, double knee, double t) {
 struct Term {
   double target, weight;
 };
-Term TermOf(double h, double model, double t, double knee, bool lag_free,
+Term TermOf(double h, double model, double level, double t, double knee, bool lag_free,
             const RiseFitOptions& options) {
   if (lag_free) return {h, options.lag_free_weight};
   if (t <= knee || h >= model) return {h, 1.0};
-  if (h >= model - options.lag_bound) return {h, options.lag_weight};
-  return {h + options.lag_bound, 1.0};
+  // an older picture of a foot that only rises: at most the model's own rise below it
+  const double bound = std::min(options.lag_bound, model - level);
+  if (h >= model - bound) return {h, options.lag_weight};
+  return {h + bound, 1.0};
 }
 
 // Huber-weighted fit at one knee: its coefficients and its total loss.
@@ -109,7 +111,7 @@ std::pair<Coefficients, double> FitAtKnee(const std::vector<double>& t,
     c = SolveWeighted(t, target, w, knee);
     for (size_t i = 0; i < t.size(); ++i) {
       const double model = Evaluate(c, knee, t[i]);
-      const Term term = TermOf(h[i], model, t[i], knee, lag_free[i], options);
+      const Term term = TermOf(h[i], model, c.level, t[i], knee, lag_free[i], options);
       target[i] = term.target;
       w[i] = HuberWeight(term.target - model, scale) * term.weight;
     }
@@ -117,7 +119,7 @@ std::pair<Coefficients, double> FitAtKnee(const std::vector<double>& t,
   double loss = 0;
   for (size_t i = 0; i < t.size(); ++i) {
     const double model = Evaluate(c, knee, t[i]);
-    const Term term = TermOf(h[i], model, t[i], knee, lag_free[i], options);
+    const Term term = TermOf(h[i], model, c.level, t[i], knee, lag_free[i], options);
     loss += HuberLoss(term.target - model, scale) * term.weight;
   }
   return {c, loss};

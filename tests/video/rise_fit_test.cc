@@ -6,10 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "support/test_support.h"
 
 namespace liftoff::video::internal {
 namespace {
@@ -227,6 +231,50 @@ TEST(FitRise, LagAwareIntervalHoldsTheTruthUnderASawtoothLag) {
               (fit.crossing_middle_s - crossing) * 1e3);
   EXPECT_LE(fit.crossing_low_s, crossing);
   EXPECT_GE(fit.crossing_high_s, crossing);
+}
+
+// Reads tests/video/data/hard3d-02-k250-rise.csv (t_s,height_px,lag_free after `#` lines
+// and a header).
+void ReadRise(std::vector<double>& t_s, std::vector<double>& h, std::vector<bool>& lag_free) {
+  std::ifstream in(testing::SourceDir() / "tests" / "video" / "data" / "hard3d-02-k250-rise.csv");
+  std::string line;
+  while (std::getline(in, line)) {
+    double t = 0, height = 0;
+    int free = 0;
+    if (line.empty() || line[0] == '#' ||
+        std::sscanf(line.c_str(), "%lf,%lf,%d", &t, &height, &free) != 3) {
+      continue;
+    }
+    t_s.push_back(t);
+    h.push_back(height);
+    lag_free.push_back(free != 0);
+  }
+}
+
+// A real curve (data/README.md): 3 s of rest that wanders by +-0.3 px (H.264 holding a noisy,
+// shaken picture with a key frame every 250 frames), then a rise the samples follow, every
+// sample allowed to lag by 3.5 px. A sample lags only behind a foot that has risen, by at
+// most the model's own rise: the rest below the level counts against an early knee, which
+// could otherwise sit on the wander's upper half as a "lagging" slow rise (its crossing
+// 0.77 s early).
+TEST(FitRise, RestBelowTheLevelIsNoCodecLagOnARealCurve) {
+  std::vector<double> t_s, h;
+  std::vector<bool> lag_free;
+  ReadRise(t_s, h, lag_free);
+  ASSERT_EQ(t_s.size(), 107u);
+  RiseFitOptions options;
+  options.threshold = 0.646473;
+  options.lag_bound = 3.506864;
+  options.lag_weight = 0.02;
+  const RiseFit fit = FitRise(t_s, h, lag_free, options);
+  ASSERT_TRUE(fit.ok);
+  constexpr double kTruthS = 19.264 - 16.166667;
+  std::printf("real curve: best crossing %+.1f ms, middle %+.1f ms, [%+.1f, %+.1f] ms\n",
+              (fit.crossing_s - kTruthS) * 1e3, (fit.crossing_middle_s - kTruthS) * 1e3,
+              (fit.crossing_low_s - kTruthS) * 1e3, (fit.crossing_high_s - kTruthS) * 1e3);
+  EXPECT_LE(fit.crossing_low_s, kTruthS);
+  EXPECT_GE(fit.crossing_high_s, kTruthS);
+  EXPECT_NEAR(fit.crossing_middle_s, kTruthS, 0.3);
 }
 
 TEST(FitRise, FewerThanEightSamplesOrMismatchedSizesAreNotOk) {
