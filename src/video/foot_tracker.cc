@@ -92,6 +92,9 @@ constexpr double kLagWeight = 0.02;
 constexpr double kMinLagPx = 0.3;
 // A catch-up is partial: the lag allowed for is this multiple of the largest one seen.
 constexpr double kLagBoundFactor = 1.5;
+// A catch-up counts beyond this many sigmas of the still foot's frame-to-frame change (its
+// rest noise times sqrt(2)): a noisy curve's changes stand out of their neighbours' by chance.
+constexpr double kCatchUpNoiseSigmas = 3.0;
 // Longest stretch of rest fitted before the rise, s.
 constexpr double kFitRestS = 3.0;
 // The curve's running median for the search, s either side.
@@ -1034,7 +1037,11 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
   if (may_lag) {
     // the catch-ups up to the fit's top, and the key frame's (higher up, where a fast rise
     // is tracked less well, other jumps are no codec's)
-    fit_options.lag_bound = internal::LagBoundPx(height, start, cut, kMinLagPx, kLagBoundFactor);
+    // (a catch-up must stand out of the still foot's frame-to-frame noise; the key frame's
+    // own, below, renews the picture: no noise)
+    fit_options.lag_bound =
+        internal::LagBoundPx(height, start, cut, kMinLagPx, kLagBoundFactor,
+                             kCatchUpNoiseSigmas * std::sqrt(2.0) * rest_noise_px);
     if (cut_with_key > cut && cut_with_key + 1 < height.size()) {
       fit_options.lag_bound = std::max(
           fit_options.lag_bound, internal::LagBoundPx(height, cut_with_key - 2, cut_with_key + 1,

@@ -65,8 +65,8 @@ size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector
   return 0;
 }
 
-double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
-                  double min_lag_px, double factor) {
+double LagBoundPx(const std::vector<double>& height, size_t first, size_t last, double min_lag_px,
+                  double factor, double noise_px) {
   const auto change = [&](size_t f) {
     const double c = height[f] - height[f - 1];
     return std::isfinite(c) ? c : 0.0;
@@ -77,7 +77,7 @@ double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
     const double after = f + 1 <= last ? change(f + 1) : 0.0;
     largest = std::max(largest, change(f) - std::max({0.0, before, after}));
   }
-  return std::max(min_lag_px, factor * largest);
+  return std::max(min_lag_px, factor * (largest - noise_px));
 }
 
 size_t SustainedCrossing(const std::vector<double>& height, size_t first, size_t last,

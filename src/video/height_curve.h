@@ -51,10 +51,11 @@ size_t ReachKeyframe(const std::vector<HeightSample>& samples, const std::vector
 /// How far a codec may have held the curve back over frames [first, last], px: its largest
 /// change in one frame beyond the larger of the changes either side of it (a frame held
 /// back changes by nothing and the next catches up; a fast rise changes by much in every
-/// frame, which is motion, not lag), times `factor` (a catch-up may be partial), at least
+/// frame, which is motion, not lag) and beyond `noise_px` (a noisy curve's changes stand out
+/// of their neighbours' by chance), times `factor` (a catch-up may be partial), at least
 /// `min_lag_px`. Needs first < last < height.size().
-double LagBoundPx(const std::vector<double>& height, size_t first, size_t last,
-                  double min_lag_px, double factor);
+double LagBoundPx(const std::vector<double>& height, size_t first, size_t last, double min_lag_px,
+                  double factor, double noise_px = 0.0);
 
 /// The curve's first sustained crossing of `level` among frames [first, last]: the first of
 /// three frames in a row at or above it; last + 1 for none.

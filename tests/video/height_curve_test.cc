@@ -33,6 +33,19 @@ TEST(LagBound, AHeldFrameAndItsCatchUpGiveTheHeldAmountTimesTheFactor) {
   EXPECT_NEAR(LagBoundPx(height, 0, 8, 0.5, 1.5), 0.5, 1e-12);  // the floor
 }
 
+TEST(LagBound, ACatchUpCountsBeyondTheNoiseOnly) {
+  // the held frame and its catch-up as above, then the noise allowance taken off the
+  // catch-up's 0.2 px; a noise allowance beyond it leaves the floor
+  const std::vector<double> height = {0, 0.2, 0.4, 0.6, 0.8, 0.8, 1.2, 1.4, 1.6};
+  EXPECT_NEAR(LagBoundPx(height, 0, 8, 0.0, 1.5, 0.05), 1.5 * 0.15, 1e-12);
+  EXPECT_NEAR(LagBoundPx(height, 0, 8, 0.3, 1.5, 0.25), 0.3, 1e-12);
+  // a still foot's noise (+-0.2 px alternating: every other change stands out by 0.4 px)
+  // is no lag once 3 sigmas of its frame-to-frame change are allowed for
+  const std::vector<double> noisy = {0, 0.2, -0.2, 0.2, -0.2, 0.2, -0.2, 0.2, -0.2};
+  EXPECT_GT(LagBoundPx(noisy, 0, 8, 0.0, 1.5), 0.5);
+  EXPECT_NEAR(LagBoundPx(noisy, 0, 8, 0.0, 1.5, 3 * std::sqrt(2.0) * 0.2), 0.0, 1e-12);
+}
+
 TEST(LagBound, AFastSmoothRiseIsMotionNotLag) {
   // accelerating by 0.1 px a frame per frame: every change is beyond the one before it by
   // 0.1 and short of the next, so only the last frame (no next) counts, by 0.1 px
