@@ -187,8 +187,7 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
     err << "liftoff synth: --keyframe-interval works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
-  if (command.set_name == "ci3d" || command.set_name == "hard3d" ||
-      command.set_name == "campaign") {
+  if (set3d || command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);
   }
   if (command.seed_offset != 0) {
@@ -220,8 +219,8 @@ Subcommand AddSynthCommand(Command& parent) {
                  "once off the ground (1 .. 20)")
       ->ShowDefault();
   app->AddOption("--keyframe-interval", command->keyframe_interval_frames,
-                 "--set ci3d or hard3d: a key frame every this many frames (0 .. 10000; 0: one "
-                 "a nominal second; a camera's H.264 often has 250)")
+                 "--set ci3d or hard3d: H.264's key frames at most this many frames apart (0 .. "
+                 "10000; 0: a nominal second; a camera's H.264 often has 250)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

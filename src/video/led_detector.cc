@@ -891,8 +891,10 @@ bool LedDetector::Impl::SumDatingSeries(int64_t k, size_t count, double clear, b
       const uint8_t* pixel = RoiPicture(slot) + 3 * i;
       const double gain = static_cast<double>(RowGains(slot)[i / width]);
       dating_series[j] += static_cast<double>(values[j]);
-      scaled = scaled && gain >= kMinRowGain;
-      if (scaled) scaled_series[j] += (pixel[0] + pixel[1] + pixel[2]) / gain;
+      if (gain < kMinRowGain)
+        scaled = false;
+      else
+        scaled_series[j] += (pixel[0] + pixel[1] + pixel[2]) / gain;
     }
   }
   if (!scaled) std::fill(scaled_series.begin(), scaled_series.end(), 0.0);

@@ -516,8 +516,7 @@ void ExpectTheSwitchOnFound(const Trial3dSpec& spec) {
   testing::ScratchDir scratch;
   const auto written = WriteTrial3d(spec, Calibration2018(), scratch.path());
   ASSERT_TRUE(written.ok()) << written.status().ToString();
-  std::ifstream in(written->truth_path);
-  const nlohmann::json truth = nlohmann::json::parse(in);
+  const nlohmann::json truth = ReadJson(written->truth_path);
   const auto roi = truth["led_roi"];
   video::ClipAnalysisOptions options;
   options.led.roi_px =

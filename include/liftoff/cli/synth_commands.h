@@ -28,8 +28,8 @@ struct SynthCommand {
   /// --rise-slowdown: ci3d and hard3d's feet rising this many times slower (1 .. 20;
   /// synth::Set3dVariation).
   double rise_slowdown = 1.0;
-  /// --keyframe-interval: ci3d and hard3d's videos with a key frame every this many frames
-  /// (0 .. 10000; 0: one a nominal second; synth::Set3dVariation).
+  /// --keyframe-interval: ci3d and hard3d's H.264 key frames at most this many frames apart
+  /// (0 .. 10000; 0: a nominal second; synth::Set3dVariation).
   int keyframe_interval_frames = 0;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;

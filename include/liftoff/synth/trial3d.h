@@ -95,7 +95,7 @@ struct Trial3dSpec {
   VideoCodec codec = VideoCodec::kH264;
   /// CRF (h264) or q:v (mjpeg), as CameraSpec.
   int quality = 20;
-  /// Frames between key frames (VideoWriterOptions::keyframe_interval_frames; 0: one a
+  /// Most frames between key frames (VideoWriterOptions::keyframe_interval_frames; 0: a
   /// nominal second).
   int keyframe_interval_frames = 0;
 
@@ -234,7 +234,7 @@ struct Set3dVariation {
   uint64_t seed_offset = 0;
   /// Every clip's Trial3dSpec::rise_slowdown (1 .. 20).
   double rise_slowdown = 1.0;
-  /// Every clip's Trial3dSpec::keyframe_interval_frames (0 .. 10000; 0: one a second).
+  /// Every clip's Trial3dSpec::keyframe_interval_frames (0 .. 10000; 0: a nominal second).
   int keyframe_interval_frames = 0;
 
   Status Validate() const;
