@@ -104,10 +104,11 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     variation.seed_offset = command.seed_offset;
     variation.rise_slowdown = command.rise_slowdown;
     variation.keyframe_interval_frames = command.keyframe_interval_frames;
+    variation.led_on_spread_s = command.led_on_spread_s;
     const std::string invalid = variation.Validate().message();
-    for (const auto& [flag, field] :
-         {std::pair{"--rise-slowdown", "rise_slowdown"},
-          std::pair{"--keyframe-interval", "keyframe_interval_frames"}}) {
+    for (const auto& [flag, field] : {std::pair{"--rise-slowdown", "rise_slowdown"},
+                                      std::pair{"--keyframe-interval", "keyframe_interval_frames"},
+                                      std::pair{"--led-on-spread", "led_on_spread_s"}}) {
       if (auto named = MessageNamingFlag(invalid, flag, field, false)) {
         return InvalidArgumentError(*named);
       }
@@ -187,6 +188,10 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
     err << "liftoff synth: --keyframe-interval works with --set ci3d or hard3d\n";
     return kExitUsage;
   }
+  if (command.led_on_spread_s != 0.0 && !set3d) {
+    err << "liftoff synth: --led-on-spread works with --set ci3d or hard3d\n";
+    return kExitUsage;
+  }
   if (set3d || command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);
   }
@@ -221,6 +226,11 @@ Subcommand AddSynthCommand(Command& parent) {
   app->AddOption("--keyframe-interval", command->keyframe_interval_frames,
                  "--set ci3d or hard3d: H.264's key frames at most this many frames apart (0 .. "
                  "10000; 0: a nominal second; a camera's H.264 often has 250)")
+      ->ShowDefault();
+  app->AddOption("--led-on-spread", command->led_on_spread_s,
+                 "--set ci3d or hard3d: every LED switch-on moved later by a draw from [0, S) "
+                 "s seeded by the clip (0 .. 10; 0: as documented, most on a frame's time and "
+                 "a key frame)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

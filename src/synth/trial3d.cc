@@ -985,22 +985,37 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
 
 Status Set3dVariation::Validate() const {
   LIFTOFF_RETURN_IF_ERROR(CheckRiseSlowdown(rise_slowdown));
+  if (!(led_on_spread_s >= 0.0 && led_on_spread_s <= 10.0)) {
+    return InvalidArgumentError("led_on_spread_s: expected 0 .. 10 s, got " +
+                                FormatNumber(led_on_spread_s));
+  }
   VideoWriterOptions writer;
   writer.keyframe_interval_frames = keyframe_interval_frames;
   return writer.Validate();
+}
+
+std::vector<Trial3dSpec> VarySet3d(std::vector<Trial3dSpec> set, const Set3dVariation& variation) {
+  // a stream of its own, so that the clip's other draws stay as they were
+  constexpr uint64_t kLedOnStream = 0x4C45444F4E5F5331ull;
+  for (Trial3dSpec& spec : set) {
+    spec.seed += variation.seed_offset;
+    spec.scene.seed += variation.seed_offset;
+    spec.rise_slowdown = variation.rise_slowdown;
+    spec.keyframe_interval_frames = variation.keyframe_interval_frames;
+    const double shift_s =
+        variation.led_on_spread_s * SplitMix64(spec.seed ^ kLedOnStream).Uniform();
+    spec.led_on_s += shift_s;
+    spec.max_duration_s += shift_s;
+  }
+  return set;
 }
 
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
                                 const Calibration& calibration, const Set3dProgress& progress,
                                 const Set3dVariation& variation) {
   LIFTOFF_RETURN_IF_ERROR(variation.Validate());
-  LIFTOFF_ASSIGN_OR_RETURN(std::vector<Trial3dSpec> set, Set3dNamed(name));
-  for (Trial3dSpec& spec : set) {
-    spec.seed += variation.seed_offset;
-    spec.scene.seed += variation.seed_offset;
-    spec.rise_slowdown = variation.rise_slowdown;
-    spec.keyframe_interval_frames = variation.keyframe_interval_frames;
-  }
+  LIFTOFF_ASSIGN_OR_RETURN(std::vector<Trial3dSpec> named, Set3dNamed(name));
+  const std::vector<Trial3dSpec> set = VarySet3d(std::move(named), variation);
   std::string varied;
   if (variation.seed_offset != 0) {
     varied += ", seeds offset by " + std::to_string(variation.seed_offset);
@@ -1011,6 +1026,9 @@ Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::
   if (variation.keyframe_interval_frames != 0) {
     varied +=
         ", a key frame every " + std::to_string(variation.keyframe_interval_frames) + " frames";
+  }
+  if (variation.led_on_spread_s != 0.0) {
+    varied += ", the LED switch-on up to " + FormatNumber(variation.led_on_spread_s) + " s later";
   }
   const std::string description =
       varied.empty() ? "" : "liftoff synth set " + name + " (" + calibration.name + ")" + varied;

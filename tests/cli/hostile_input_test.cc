@@ -297,6 +297,11 @@ const std::vector<HostileCase>& Cases() {
       {"synth --keyframe-interval out of range", nullptr,
        "synth --set hard3d --keyframe-interval 20000 -o @/set -q", 3,
        {"--keyframe-interval", "20000", "10000"}},
+      {"synth --led-on-spread with a 2D set", nullptr,
+       "synth --set ci --led-on-spread 1 -o @/set", 2, {"--led-on-spread", "ci3d or hard3d"}},
+      {"synth --led-on-spread out of range", nullptr,
+       "synth --set hard3d --led-on-spread 11 -o @/set -q", 3,
+       {"--led-on-spread", "11", "0 .. 10"}},
       {"sim sweep --hardware of a missing manifest", nullptr,
        "sim sweep --hardware @/missing.json --progress off", 4, {"--hardware", "missing.json"},
        {"s wall"}},  // failed before the sweep, not after it

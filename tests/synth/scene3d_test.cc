@@ -446,6 +446,36 @@ TEST(Trial3d, ASlowerRiseStretchesTheLiftAfterTheGroundContact) {
   EXPECT_NE(variation.Validate().message().find("keyframe_interval_frames"), std::string::npos);
 }
 
+// --led-on-spread: each clip's switch-on moves later by its own seeded draw, inside the
+// spread, the clip's end with it; the draw follows the varied seed; 0 leaves the set as
+// documented.
+TEST(Trial3d, ALedOnSpreadMovesEachSwitchOnByItsOwnDraw) {
+  const std::vector<Trial3dSpec> named = Hard3dSet();
+  EXPECT_EQ(VarySet3d(named, {})[0].led_on_s, named[0].led_on_s);
+  Set3dVariation variation;
+  variation.led_on_spread_s = 1.0;
+  const std::vector<Trial3dSpec> spread = VarySet3d(named, variation);
+  ASSERT_EQ(spread.size(), named.size());
+  std::vector<double> phases_frames;
+  for (size_t i = 0; i < named.size(); ++i) {
+    const double shift_s = spread[i].led_on_s - named[i].led_on_s;
+    EXPECT_GE(shift_s, 0.0) << named[i].id;
+    EXPECT_LT(shift_s, 1.0) << named[i].id;
+    EXPECT_NEAR(spread[i].max_duration_s - named[i].max_duration_s, shift_s, 1e-12) << named[i].id;
+    EXPECT_TRUE(spread[i].Validate().ok()) << named[i].id;
+    const double frames = spread[i].led_on_s * spread[i].fps;
+    phases_frames.push_back(frames - std::floor(frames));
+  }
+  // not one phase for all: the switch-ons fall at different points of a frame
+  const auto [low, high] = std::minmax_element(phases_frames.begin(), phases_frames.end());
+  EXPECT_GT(*high - *low, 0.5);
+  EXPECT_EQ(VarySet3d(named, variation)[3].led_on_s, spread[3].led_on_s);  // reproducible
+  variation.seed_offset = 1000;
+  EXPECT_NE(VarySet3d(named, variation)[3].led_on_s, spread[3].led_on_s);
+  variation.led_on_spread_s = 10.5;
+  EXPECT_NE(variation.Validate().message().find("led_on_spread_s"), std::string::npos);
+}
+
 TEST(Trial3d, LedFractionOfTheCentredExposure) {
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 1.0), 0.5, 1e-12);
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 0.995), 0.75, 1e-12);

@@ -31,6 +31,9 @@ struct SynthCommand {
   /// --keyframe-interval: ci3d and hard3d's H.264 key frames at most this many frames apart
   /// (0 .. 10000; 0: a nominal second; synth::Set3dVariation).
   int keyframe_interval_frames = 0;
+  /// --led-on-spread: ci3d and hard3d's LED switch-ons each moved later by a seeded draw
+  /// from [0, this) s (0 .. 10; synth::Set3dVariation).
+  double led_on_spread_s = 0.0;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.

@@ -236,9 +236,16 @@ struct Set3dVariation {
   double rise_slowdown = 1.0;
   /// Every clip's Trial3dSpec::keyframe_interval_frames (0 .. 10000; 0: a nominal second).
   int keyframe_interval_frames = 0;
+  /// Every clip's LED switch-on (and the ramp, and the clip's end with it) moved later by a
+  /// draw from [0, this) s seeded by the clip's seed, s (0 .. 10; 0: as documented, where
+  /// most switch-ons fall on a frame's presentation time and a key frame): the switch-on at
+  /// any phase of a frame and between key frames, as a camera started by hand has it.
+  double led_on_spread_s = 0.0;
 
   Status Validate() const;
 };
+/// `set` varied by `variation` (valid): the specs WriteSet3d writes.
+std::vector<Trial3dSpec> VarySet3d(std::vector<Trial3dSpec> set, const Set3dVariation& variation);
 /// The named set (Set3dNamed) through WriteSpecs3d, varied by `variation`.
 Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::path& output_dir,
                                 const Calibration& calibration, const Set3dProgress& progress = {},
