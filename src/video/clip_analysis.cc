@@ -369,6 +369,7 @@ json ClipAnalysis::ToJson() const {
                       {"first_lit_frame", pulse.first_lit_frame},
                       {"first_lit_fraction", pulse.first_lit_fraction},
                       {"missing_frames_before_on", pulse.missing_frames_before_on},
+                      {"spread_frames", pulse.spread_frames},
                       {"off_s", pulse.off_ns ? json(SecondsFromNs(*pulse.off_ns)) : json()}});
   }
   json document = {

@@ -1444,10 +1444,23 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
     const bool built_up = event.build_up_frames > 1;
     if (built_up) lit = kBeforeFrames;
     const double f = std::clamp(fraction(lit), 0.0, 1.0);
-    const internal::SwitchOnDating dating = internal::DateSwitchOn(
+    internal::SwitchOnDating dating = internal::DateSwitchOn(
         static_cast<double>(event.t_ns[lit - 1]), dark, static_cast<double>(event.t_ns[lit]),
         built_up ? LitFraction{0.0, 1.0} : lit_band(f), exposure,
         static_cast<double>(event.period_ns));
+    // the frames lit part way around the dated one: two or more in a row, and the switch-on
+    // may be anywhere between the last dark frame and the first wholly lit one
+    size_t first_partial = lit, first_whole = lit;
+    while (first_partial >= 2 && fraction(first_partial - 1) > lit_above) --first_partial;
+    while (first_whole + 1 < count && fraction(first_whole) < 1.0 - band) ++first_whole;
+    pulse.spread_frames = static_cast<int>(first_whole - first_partial);
+    if (!built_up && pulse.spread_frames >= 2) {
+      const InstantInterval spread = internal::SwitchOnInterval(
+          static_cast<double>(event.t_ns[first_partial - 1]), dark,
+          static_cast<double>(event.t_ns[first_whole]), LitFraction{0.0, 1.0}, exposure);
+      dating.surely = {std::min(dating.surely.low_ns, spread.low_ns),
+                       std::max(dating.surely.high_ns, spread.high_ns)};
+    }
     pulse.on_ns = static_cast<int64_t>(std::llround(dating.estimate_ns));
     pulse.on_uncertainty_ns = dating.HalfWidth();
     pulse.missing_frames_before_on = dating.missing_frames;
@@ -1608,6 +1621,17 @@ Result<LedResult> LedDetector::Impl::Finish() const {
         " (a codec held the light at a partial level or let it wobble): dated from the first "
         "frame that changed, lit for an unknown part of its exposure, +- " +
         FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) + " ms");
+  }
+  if (first_build_up_frames <= 1 && !result.pulses.empty() &&
+      result.pulses.front().spread_frames >= 2) {
+    const LedPulse& first = result.pulses.front();
+    result.warnings.push_back(
+        "switched on part way over " + std::to_string(first.spread_frames) +
+        " frames in a row from frame " + std::to_string(first.first_lit_frame) +
+        " (one switch-on lights one frame part way: a codec blended the step, as H.264's "
+        "B-frames do a small light's): its +- " +
+        FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) +
+        " ms reaches from the last dark frame to the first wholly lit one");
   }
   if (already_on) {
     result.warnings.push_back(

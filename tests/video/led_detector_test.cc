@@ -477,6 +477,36 @@ TEST(LedDetector, AFaintLedACodecBuildsUpOverFramesIsFound) {
   EXPECT_FALSE(SaysBuiltUp(*result)) << result->Brief();
 }
 
+// H.264's B-frames blend a faint tiny LED's step between their reference frames (hard3d-06
+// with --seed 20000 --keyframe-interval 250 --led-on-spread 1: P-frame 87 dark, B-frames 88
+// and 89 at 0.29 and 0.68 of the step, P-frame 90 whole; 88 was half lit). Two frames in a
+// row lit part way is no switch-on's: the frame after the half-lit one is dated, a frame
+// late, but its interval reaches from the last dark frame to the first whole one and says so.
+TEST(LedDetector, AStepACodecBlendsOverTwoFramesWidensItsIntervalOverBoth) {
+  TinyLedStream stream = FrozenFaintLed({0.66, 0.67});
+  const double t45_ns = 45 * stream.PeriodNs();
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_TRUE(result.ok()) << result.status().ToString();
+  ASSERT_EQ(result->pulses.size(), 1u) << result->Brief();
+  const LedPulse& pulse = result->pulses[0];
+  EXPECT_EQ(pulse.spread_frames, 2) << result->Brief();
+  const double error_ns = static_cast<double>(pulse.on_ns) - *stream.on_s * 1e9;
+  EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns)) << result->Brief();
+  // the exposure not told: from frame 44's timestamp to frame 47's at least
+  EXPECT_LE(static_cast<double>(pulse.on_ns - pulse.on_uncertainty_ns),
+            t45_ns - stream.PeriodNs() + 1e3);
+  EXPECT_GE(static_cast<double>(pulse.on_ns + pulse.on_uncertainty_ns),
+            t45_ns + 2 * stream.PeriodNs() - 1e3);
+  EXPECT_TRUE(std::any_of(
+      result->warnings.begin(), result->warnings.end(),
+      [](const std::string& w) { return w.find("part way over 2 frames") != std::string::npos; }))
+      << ::testing::PrintToString(result->warnings);
+  // one half-lit frame is the light's own: no spread
+  const std::optional<LedResult> plain = DetectOnePulseAroundTheTruth(FrozenFaintLed({}));
+  ASSERT_TRUE(plain);
+  EXPECT_LE(plain->pulses[0].spread_frames, 1) << plain->Brief();
+}
+
 // A build-up the one-step window cannot see (hard3d-06 drawn with --rise-slowdown 3): the
 // detector dates the first frame that changed, lit for an unknown part of its exposure, and
 // says so.
