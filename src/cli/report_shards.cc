@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr std::string_view kShardFormat = "liftoff-report-shard";
-constexpr int kShardVersion = 2;  // 2: LED pulses carry missing_frames_before_on
+constexpr int kShardVersion = 3;  // 2: LED pulses carry missing_frames_before_on; 3: spread_frames
 
 // ---------------------------------------------------------------------------------------
 // values: numbers that may be NaN (JSON null), optionals, rectangles, statuses
@@ -225,7 +225,8 @@ json LedJson(const video::LedResult& led) {
   json pulses = json::array();
   for (const video::LedPulse& p : led.pulses) {
     pulses.push_back({p.on_ns, p.on_uncertainty_ns, p.first_lit_frame, Number(p.first_lit_fraction),
-                      Optional(p.off_ns), p.off_uncertainty_ns, p.missing_frames_before_on});
+                      Optional(p.off_ns), p.off_uncertainty_ns, p.missing_frames_before_on,
+                      p.spread_frames});
   }
   return {{"roi_px", Rect(led.roi_px)},
           {"roi_located", led.roi_located},
@@ -254,6 +255,7 @@ video::LedResult LedAt(const json& j) {
     pulse.off_ns = OptionalFrom<int64_t>(p.at(4));
     pulse.off_uncertainty_ns = p.at(5).get<int64_t>();
     pulse.missing_frames_before_on = p.at(6).get<int>();
+    pulse.spread_frames = p.at(7).get<int>();
   }
   led.warnings = j.at("warnings").get<std::vector<std::string>>();
   led.trace_t_ns = j.at("trace_t_ns").get<std::vector<int64_t>>();
