@@ -97,6 +97,9 @@ constexpr double kLagBoundFactor = 1.5;
 constexpr double kCatchUpNoiseSigmas = 3.0;
 // Longest stretch of rest fitted before the rise, s.
 constexpr double kFitRestS = 3.0;
+// A key frame that resets a drift (internal::ResetsADrift) begins the rest when at least
+// this long lies between it and the cut, s.
+constexpr double kRestAfterResetS = 1.0;
 // The curve's running median for the search, s either side.
 constexpr double kSmoothHalfS = 0.15;
 // A lift is sustained for this long (and this many frames at least), s; the rest before
@@ -954,6 +957,13 @@ size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector
       const size_t key = lossy && resting ? KeyframeNear(samples, f, half) : 0;
       if (key == 0) break;
       const double step = internal::LevelStep(levelled, key, 2 * half + 1);
+      // a key frame that undoes its predicted frames' drift: levelling would leave the drift
+      // as a rise into the rest, so the rest begins at it (when that leaves enough)
+      if (internal::ResetsADrift(samples, levelled_smooth, key, step, 2 * half + 1) &&
+          Seconds(samples[cut].t_ns - samples[key].t_ns) >= kRestAfterResetS) {
+        start = std::max(start, key);
+        break;
+      }
       for (size_t g = first; g < key; ++g) {
         levelled[g] += step;
         levelled_smooth[g] += step;

@@ -22,6 +22,21 @@ double LevelStep(const std::vector<double>& curve, size_t key, size_t count) {
   return std::isfinite(step) ? step : 0.0;
 }
 
+bool ResetsADrift(const std::vector<HeightSample>& samples, const std::vector<double>& curve,
+                  size_t key, double step, size_t count) {
+  size_t previous = key;
+  while (previous-- > 0 && !samples[previous].keyframe) {
+  }
+  if (previous >= key || key - previous < 2 * count) return false;
+  const auto median_of = [&](size_t from) {
+    std::vector<double> values(curve.begin() + static_cast<std::ptrdiff_t>(from),
+                               curve.begin() + static_cast<std::ptrdiff_t>(from + count));
+    return FiniteMedian(values);
+  };
+  const double drift = median_of(key - count) - median_of(previous);
+  return drift * step < 0 && std::abs(drift) >= 0.5 * std::abs(step);
+}
+
 void LevelQuietKeyframes(const std::vector<HeightSample>& samples, size_t start, size_t cut,
                          size_t frames, double quiet_px, std::vector<double>& levelled) {
   const auto holds = [&](size_t from, size_t to) {  // frames [from, to)

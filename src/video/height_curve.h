@@ -16,6 +16,15 @@ namespace liftoff::video::internal {
 /// the `count` before it (0 where either has no finite value).
 double LevelStep(const std::vector<double>& curve, size_t key, size_t count);
 
+/// Whether key frame `key`'s step (`step`, LevelStep) undoes a drift of the predicted frames
+/// before it: since the previous key frame the curve moved from its level there by at least
+/// half the step, the other way (a codec's prediction errors piling up until the picture is
+/// renewed), rather than holding a level the key frame changed (a new picture quality).
+/// Medians of `count` frames at each end of that stretch; false without an earlier key frame
+/// `2 count` frames or more before.
+bool ResetsADrift(const std::vector<HeightSample>& samples, const std::vector<double>& curve,
+                  size_t key, double step, size_t count);
+
 /// A key frame between still stretches renews the picture's quality, not the foot's place:
 /// for each key frame among frames (start, cut] where the `frames` frames before it and the
 /// `frames` from it on each hold within `quiet_px`, the frames from `start` to it are

@@ -171,6 +171,38 @@ TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
   EXPECT_EQ(LevelStep(std::vector<double>(4, nan), 2, 2), 0.0);
 }
 
+TEST(ResetsADrift, AKeyFrameUndoingItsPredictedFramesDriftButNotANewLevel) {
+  // key frames at 0, 20 and 40 (hard3d-07, --seed 21000 --led-on-spread 1: the curve held
+  // 0.55 px from one key frame, crept to 0.84 in three codec steps and fell to 0.3 at the
+  // next)
+  std::vector<HeightSample> samples = Samples(60);
+  samples[0].keyframe = samples[20].keyframe = samples[40].keyframe = true;
+  std::vector<double> drift(60, 0.55);
+  for (size_t f = 30; f < 33; ++f) drift[f] = 0.74;
+  for (size_t f = 33; f < 40; ++f) drift[f] = 0.84;
+  for (size_t f = 40; f < 60; ++f) drift[f] = 0.3;
+  const double reset = LevelStep(drift, 40, 5);
+  EXPECT_NEAR(reset, -0.54, 1e-12);
+  EXPECT_TRUE(ResetsADrift(samples, drift, 40, reset, 5));
+  // the same step after a stretch that held its level: a new picture quality
+  std::vector<double> held(60, 0.84);
+  for (size_t f = 40; f < 60; ++f) held[f] = 0.3;
+  EXPECT_FALSE(ResetsADrift(samples, held, 40, LevelStep(held, 40, 5), 5));
+  // a drift under half the step, or the step's way, resets nothing
+  std::vector<double> small = held;
+  for (size_t f = 20; f < 30; ++f) small[f] = 0.7;
+  EXPECT_FALSE(ResetsADrift(samples, small, 40, LevelStep(small, 40, 5), 5));
+  std::vector<double> along = drift;
+  for (size_t f = 40; f < 60; ++f) along[f] = 1.3;
+  EXPECT_FALSE(ResetsADrift(samples, along, 40, LevelStep(along, 40, 5), 5));
+  // no earlier key frame far enough back to measure from
+  samples[20].keyframe = false;
+  samples[0].keyframe = false;
+  EXPECT_FALSE(ResetsADrift(samples, drift, 40, reset, 5));
+  samples[35].keyframe = true;
+  EXPECT_FALSE(ResetsADrift(samples, drift, 40, reset, 5));
+}
+
 TEST(KeyframeNoise, TheKeyFramesScatterWhereTheFramesBetweenCopyAStillPicture) {
   // 60 frames, a key frame every 10: the frames between copy their key frame exactly (no
   // noise in any window between), the key frames at 0, 0.2, -0.1, 0.1, 0.1, 0.3 px: their
