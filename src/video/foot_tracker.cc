@@ -1291,9 +1291,9 @@ std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
   return why;
 }
 
-// A foot does not sink into the ground: a curve that goes below the rest level by more than
-// kSunkThresholds thresholds before its rise measures more than the foot (a leg tilting
-// as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
+// A foot does not sink into the ground: a curve whose running median goes below the rest
+// level by more than kSunkThresholds thresholds before its rise measures more than the foot (a leg
+// tilting as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
 // known to lie between the curve's last frame within a threshold of rest and the crossing
 // with its own uncertainty (internal::SunkCrossing): the instant moves to the middle of
 // that interval. Returns why, or "" when the curve did not sink.
@@ -1303,7 +1303,9 @@ std::string CheckSinking(const std::vector<HeightSample>& samples,
   size_t at = search.fit_first;
   while (at < search.fit_last && Seconds(samples[at].t_ns) < crossing_s) ++at;
   const double level = track.rest_rise_px, threshold = track.threshold_px;  // the rest window's
-  const internal::Sinking sank = internal::SankBefore(samples, height, search.fit_first, at, level,
+  // on the running median, as the rise is found: no few frames decide
+  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
+  const internal::Sinking sank = internal::SankBefore(samples, smooth, search.fit_first, at, level,
                                                       threshold, kSunkThresholds * threshold);
   if (!sank.sank) return "";
   const double found_s = crossing_s;
