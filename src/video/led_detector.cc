@@ -1448,24 +1448,29 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
         static_cast<double>(event.t_ns[lit - 1]), dark, static_cast<double>(event.t_ns[lit]),
         built_up ? LitFraction{0.0, 1.0} : lit_band(f), exposure,
         static_cast<double>(event.period_ns));
-    // the frames lit part way around the dated one: two or more in a row, and the switch-on
-    // may be anywhere between the last dark frame and the first wholly lit one
+    pulse.first_lit_frame = event.index[lit];
+    pulse.first_lit_fraction = f;
+    // the frames lit part way around the dated one (a build-up has its own rule): two or
+    // more in a row, and the switch-on may be anywhere between the last dark frame and the
+    // first wholly lit one
     size_t first_partial = lit, first_whole = lit;
     while (first_partial >= 2 && fraction(first_partial - 1) > lit_above) --first_partial;
     while (first_whole + 1 < count && fraction(first_whole) < 1.0 - band) ++first_whole;
-    pulse.spread_frames = static_cast<int>(first_whole - first_partial);
-    if (!built_up && pulse.spread_frames >= 2) {
+    pulse.spread_frames = built_up ? 0 : static_cast<int>(first_whole - first_partial);
+    if (pulse.spread_frames >= 2) {
+      const bool whole = fraction(first_whole) >= 1.0 - band;
       const InstantInterval spread = internal::SwitchOnInterval(
           static_cast<double>(event.t_ns[first_partial - 1]), dark,
-          static_cast<double>(event.t_ns[first_whole]), LitFraction{0.0, 1.0}, exposure);
+          static_cast<double>(event.t_ns[first_whole]),
+          whole ? LitFraction{1.0 - band, 1.0} : LitFraction{0.0, 1.0}, exposure);
       dating.surely = {std::min(dating.surely.low_ns, spread.low_ns),
                        std::max(dating.surely.high_ns, spread.high_ns)};
+      pulse.first_lit_frame = event.index[first_partial];
+      pulse.first_lit_fraction = std::clamp(fraction(first_partial), 0.0, 1.0);
     }
     pulse.on_ns = static_cast<int64_t>(std::llround(dating.estimate_ns));
     pulse.on_uncertainty_ns = dating.HalfWidth();
     pulse.missing_frames_before_on = dating.missing_frames;
-    pulse.first_lit_frame = event.index[lit];
-    pulse.first_lit_fraction = f;
   } else {
     // the last frame above the threshold (the after-window frames are below it), or the
     // partly lit one just after it
@@ -1628,8 +1633,9 @@ Result<LedResult> LedDetector::Impl::Finish() const {
     result.warnings.push_back(
         "switched on part way over " + std::to_string(first.spread_frames) +
         " frames in a row from frame " + std::to_string(first.first_lit_frame) +
-        " (one switch-on lights one frame part way: a codec blended the step, as H.264's "
-        "B-frames do a small light's): its +- " +
+        " (an exposure no longer than the frame interval lights one frame part way: a codec "
+        "spread the step, building a small light up or blending it over H.264's B-frames): "
+        "its +- " +
         FormatFixed(1e-6 * static_cast<double>(first.on_uncertainty_ns), 1) +
         " ms reaches from the last dark frame to the first wholly lit one");
   }

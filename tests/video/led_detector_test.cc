@@ -473,8 +473,10 @@ TEST(LedDetector, AFaintLedACodecBuildsUpOverFramesIsFound) {
   const std::optional<LedResult> result =
       DetectOnePulseAroundTheTruth(FrozenFaintLed({1.2, 0.7, 0.9}));
   ASSERT_TRUE(result);
-  // a step whose frames after it creep up: dated by its partly lit frame, no build-up
+  // a step whose frames after it creep up: dated by its partly lit frame, no build-up, and
+  // the two frames lit part way widen the interval over both
   EXPECT_FALSE(SaysBuiltUp(*result)) << result->Brief();
+  EXPECT_GE(result->pulses[0].spread_frames, 2) << result->Brief();
 }
 
 // H.264's B-frames blend a faint tiny LED's step between their reference frames (hard3d-06
@@ -497,9 +499,12 @@ TEST(LedDetector, AStepACodecBlendsOverTwoFramesWidensItsIntervalOverBoth) {
             t45_ns - stream.PeriodNs() + 1e3);
   EXPECT_GE(static_cast<double>(pulse.on_ns + pulse.on_uncertainty_ns),
             t45_ns + 2 * stream.PeriodNs() - 1e3);
-  EXPECT_TRUE(std::any_of(
-      result->warnings.begin(), result->warnings.end(),
-      [](const std::string& w) { return w.find("part way over 2 frames") != std::string::npos; }))
+  EXPECT_EQ(pulse.first_lit_frame, 45) << result->Brief();
+  EXPECT_TRUE(std::any_of(result->warnings.begin(), result->warnings.end(),
+                          [](const std::string& w) {
+                            return w.find("part way over 2 frames in a row from frame 45") !=
+                                   std::string::npos;
+                          }))
       << ::testing::PrintToString(result->warnings);
   // one half-lit frame is the light's own: no spread
   const std::optional<LedResult> plain = DetectOnePulseAroundTheTruth(FrozenFaintLed({}));

@@ -87,10 +87,12 @@ struct LedPulse {
   /// switch-on, and on_uncertainty_ns still covers the whole gap. 0 without a gap, or
   /// when a partly lit first frame dates the switch-on itself.
   int missing_frames_before_on = 0;
-  /// Frames in a row lit part way at the switch-on (1 or 0 normally; 2 or more a codec
-  /// spread the step, which one switch-on cannot do, as H.264's B-frames blend a small
-  /// light's step between their reference frames): on_uncertainty_ns then reaches from the
-  /// last dark frame to the first wholly lit one.
+  /// Frames in a row lit part way at the switch-on (0 or 1 normally; 2 or more a codec
+  /// spread the step, which one switch-on cannot do with an exposure no longer than the
+  /// frame interval: it built a small light up, or H.264's B-frames blended its step between
+  /// their reference frames): on_uncertainty_ns then reaches from the last dark frame to the
+  /// first wholly lit one, and first_lit_frame is the first of them. 0 after a build-up the
+  /// one-step window could not see (LedResult::warnings), which has its own interval.
   int spread_frames = 0;
   /// Switch-off instant, ns, when the LED went off again within the clip.
   std::optional<int64_t> off_ns;
