@@ -485,6 +485,23 @@ TEST(FootTracker, ASmallRobotsStillFootAKeyFrameMovedUnderTwoPxIsNoLift) {
       << track.status().message();
 }
 
+// A round textured foot (10 px radius, at (100, 95)) on a textured floor (seeds `seed` and
+// `seed` + 1), shown `shown_px(t_s)` px up, tracked as TrackDrawn does.
+Result<FootTrack> TrackDrawnRoundFoot(const FootTracker::Options& options, int64_t count,
+                                      const std::function<double(double)>& shown_px, uint64_t seed,
+                                      const std::function<bool(int64_t)>& is_key = {}) {
+  const cv::Size size(200, 150);
+  const cv::Mat floor = Texture(size, seed, 90, 200), foot = Texture(size, seed + 1, 0, 60);
+  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
+  cv::circle(foot_mask, cv::Point(100, 95), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
+  const auto draw = [&](double t_s) {
+    const double up_px = shown_px(t_s);
+    const cv::Mat f = ShiftedUp(foot_mask, up_px);
+    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, up_px).mul(f));
+  };
+  return TrackDrawn(options, count, draw, is_key);
+}
+
 // A foot whose predicted frames drift, as H.264 showed re-drawn hard3d-07 (--seed 21000
 // --led-on-spread 1): a key frame a second; in the one from 4 s the shown edge creeps up by
 // 0.3 px in three codec steps, and the key frame at 5 s shows it 0.55 px lower, where it
@@ -493,10 +510,6 @@ TEST(FootTracker, ASmallRobotsStillFootAKeyFrameMovedUnderTwoPxIsNoLift) {
 // the drift became a rise into the rest, and with the lag-free key frames rising one after
 // another the knee came early.
 TEST(FootTracker, AKeyFrameThatUndoesADriftBeginsTheRest) {
-  const cv::Size size(200, 150);
-  const cv::Mat floor = Texture(size, 12, 90, 200), foot = Texture(size, 13, 0, 60);
-  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
-  cv::circle(foot_mask, cv::Point(100, 95), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
   const auto shown_px = [](double t_s) {
     const double x = t_s - 5.78;
     if (t_s >= 6.0 - 1e-6) return -0.25 + 2.0 * x + 2.0 * x * x;
@@ -505,14 +518,10 @@ TEST(FootTracker, AKeyFrameThatUndoesADriftBeginsTheRest) {
     if (t_s >= 4.5) return 0.2;
     return t_s >= 4.3 ? 0.1 : 0.0;
   };
-  const auto draw = [&](double t_s) {
-    const cv::Mat f = ShiftedUp(foot_mask, shown_px(t_s));
-    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px(t_s)).mul(f));
-  };
   FootTracker::Options options = DrawnOptions(cv::Rect(70, 50, 60, 60));
   options.compression_error_px = 0.2;  // a lossy codec
-  const Result<FootTrack> track =
-      TrackDrawn(options, 240, draw, [](int64_t index) { return index % 30 == 0; });
+  const Result<FootTrack> track = TrackDrawnRoundFoot(
+      options, 240, shown_px, 12, [](int64_t index) { return index % 30 == 0; });
   ASSERT_TRUE(track.ok()) << track.status().ToString();
   const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
   const double truth_s = 5.78 + (-2.0 + std::sqrt(4.0 + 4 * 2.0 * 0.5)) / (2 * 2.0);
@@ -529,20 +538,13 @@ TEST(FootTracker, AKeyFrameThatUndoesADriftBeginsTheRest) {
 // the crossing stands (taken for a sinking, the instant moved to the middle of the dip and
 // the crossing, 0.8 s early).
 TEST(FootTracker, AFewFramesBelowRestAreNoSinking) {
-  const cv::Size size(200, 150);
-  const cv::Mat floor = Texture(size, 14, 90, 200), foot = Texture(size, 15, 0, 60);
-  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
-  cv::circle(foot_mask, cv::Point(100, 95), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
   const auto shown_px = [](double t_s) {
     const double x = t_s - 5.0;
     if (t_s >= 5.0) return x + x * x;
     return t_s >= 4.0 && t_s < 4.09 ? -1.3 : 0.0;
   };
-  const auto draw = [&](double t_s) {
-    const cv::Mat f = ShiftedUp(foot_mask, shown_px(t_s));
-    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px(t_s)).mul(f));
-  };
-  const Result<FootTrack> track = TrackDrawn(DrawnOptions(cv::Rect(70, 50, 60, 60)), 210, draw);
+  const Result<FootTrack> track =
+      TrackDrawnRoundFoot(DrawnOptions(cv::Rect(70, 50, 60, 60)), 210, shown_px, 14);
   ASSERT_TRUE(track.ok()) << track.status().ToString();
   const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
   const double truth_s = 5.0 + (-1.0 + std::sqrt(1.0 + 4 * 0.5)) / 2;
