@@ -443,24 +443,35 @@ TEST(FootTracker, PatchesDisagreeingOnTheCrossingWidenTheInterval) {
   EXPECT_LT(uncertainty_s, 0.6) << track->Brief();
 }
 
+// A round textured foot (10 px radius, centred at `centre_px`) on a textured floor (seeds
+// `seed` and `seed` + 1), shown `shown_px(t_s)` px up, tracked as TrackDrawn does.
+Result<FootTrack> TrackDrawnRoundFoot(const FootTracker::Options& options, int64_t count,
+                                      const std::function<double(double)>& shown_px, uint64_t seed,
+                                      cv::Point centre_px,
+                                      const std::function<bool(int64_t)>& is_key = {}) {
+  const cv::Size size(200, 150);
+  const cv::Mat floor = Texture(size, seed, 90, 200), foot = Texture(size, seed + 1, 0, 60);
+  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
+  cv::circle(foot_mask, centre_px, 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
+  const auto draw = [&](double t_s) {
+    const double up_px = shown_px(t_s);
+    const cv::Mat f = ShiftedUp(foot_mask, up_px);
+    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, up_px).mul(f));
+  };
+  return TrackDrawn(options, count, draw, is_key);
+}
+
 // A still foot as H.264 shows it (shared/video-dev's d12 encoded again by OpenCV's H.264
 // writer): a key frame every 2 s, the frames between copy it; the key frame at 6 s renews
 // the picture with the foot's edge `step_px` higher, and it stays there to the end, 4 s on.
 // Tracked through a lossy codec with `threshold_px`.
 Result<FootTrack> TrackStillFootAKeyFrameMoved(double step_px, double threshold_px) {
-  const cv::Size size(200, 150);
-  const cv::Mat floor = Texture(size, 10, 90, 200), foot = Texture(size, 11, 0, 60);
-  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
-  cv::circle(foot_mask, cv::Point(100, 88), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
-  const auto draw = [&](double t_s) {
-    const double shown_px = t_s >= 6.0 - 1e-6 ? step_px : 0.0;
-    const cv::Mat f = ShiftedUp(foot_mask, shown_px);
-    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, shown_px).mul(f));
-  };
   FootTracker::Options options = DrawnOptions(cv::Rect(75, 55, 50, 50));
   options.threshold_px = threshold_px;
   options.compression_error_px = 0.2;  // a lossy codec
-  return TrackDrawn(options, 300, draw, [](int64_t index) { return index % 60 == 0; });
+  return TrackDrawnRoundFoot(
+      options, 300, [step_px](double t_s) { return t_s >= 6.0 - 1e-6 ? step_px : 0.0; }, 10,
+      cv::Point(100, 88), [](int64_t index) { return index % 60 == 0; });
 }
 
 TEST(FootTracker, AStillFootAKeyFrameMovedThreeThresholdsIsNoLift) {
@@ -485,23 +496,6 @@ TEST(FootTracker, ASmallRobotsStillFootAKeyFrameMovedUnderTwoPxIsNoLift) {
       << track.status().message();
 }
 
-// A round textured foot (10 px radius, at (100, 95)) on a textured floor (seeds `seed` and
-// `seed` + 1), shown `shown_px(t_s)` px up, tracked as TrackDrawn does.
-Result<FootTrack> TrackDrawnRoundFoot(const FootTracker::Options& options, int64_t count,
-                                      const std::function<double(double)>& shown_px, uint64_t seed,
-                                      const std::function<bool(int64_t)>& is_key = {}) {
-  const cv::Size size(200, 150);
-  const cv::Mat floor = Texture(size, seed, 90, 200), foot = Texture(size, seed + 1, 0, 60);
-  cv::Mat foot_mask(size, CV_32FC1, cv::Scalar(0));
-  cv::circle(foot_mask, cv::Point(100, 95), 10, cv::Scalar(1.0), cv::FILLED, cv::LINE_AA);
-  const auto draw = [&](double t_s) {
-    const double up_px = shown_px(t_s);
-    const cv::Mat f = ShiftedUp(foot_mask, up_px);
-    return cv::Mat(floor.mul(1 - f) + ShiftedUp(foot, up_px).mul(f));
-  };
-  return TrackDrawn(options, count, draw, is_key);
-}
-
 // A foot whose predicted frames drift, as H.264 showed re-drawn hard3d-07 (--seed 21000
 // --led-on-spread 1): a key frame a second; in the one from 4 s the shown edge creeps up by
 // 0.3 px in three codec steps, and the key frame at 5 s shows it 0.55 px lower, where it
@@ -520,8 +514,9 @@ TEST(FootTracker, AKeyFrameThatUndoesADriftBeginsTheRest) {
   };
   FootTracker::Options options = DrawnOptions(cv::Rect(70, 50, 60, 60));
   options.compression_error_px = 0.2;  // a lossy codec
-  const Result<FootTrack> track = TrackDrawnRoundFoot(
-      options, 240, shown_px, 12, [](int64_t index) { return index % 30 == 0; });
+  const Result<FootTrack> track =
+      TrackDrawnRoundFoot(options, 240, shown_px, 12, cv::Point(100, 95),
+                          [](int64_t index) { return index % 30 == 0; });
   ASSERT_TRUE(track.ok()) << track.status().ToString();
   const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
   const double truth_s = 5.78 + (-2.0 + std::sqrt(4.0 + 4 * 2.0 * 0.5)) / (2 * 2.0);
@@ -543,8 +538,8 @@ TEST(FootTracker, AFewFramesBelowRestAreNoSinking) {
     if (t_s >= 5.0) return x + x * x;
     return t_s >= 4.0 && t_s < 4.09 ? -1.3 : 0.0;
   };
-  const Result<FootTrack> track =
-      TrackDrawnRoundFoot(DrawnOptions(cv::Rect(70, 50, 60, 60)), 210, shown_px, 14);
+  const Result<FootTrack> track = TrackDrawnRoundFoot(DrawnOptions(cv::Rect(70, 50, 60, 60)), 210,
+                                                      shown_px, 14, cv::Point(100, 95));
   ASSERT_TRUE(track.ok()) << track.status().ToString();
   const double found_s = static_cast<double>(track->above_threshold.t_ns) * 1e-9;
   const double truth_s = 5.0 + (-1.0 + std::sqrt(1.0 + 4 * 0.5)) / 2;
