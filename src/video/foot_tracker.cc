@@ -958,8 +958,10 @@ size_t FindRestStart(const std::vector<HeightSample>& samples, const std::vector
       if (key == 0) break;
       const double step = internal::LevelStep(levelled, key, 2 * half + 1);
       // a key frame that undoes its predicted frames' drift: levelling would leave the drift
-      // as a rise into the rest, so the rest begins at it (when that leaves enough)
-      if (internal::ResetsADrift(samples, levelled_smooth, key, step, 2 * half + 1) &&
+      // as a rise into the rest, so the rest begins at it (when that leaves enough; a key
+      // frame levelled already has no step left to judge)
+      if (key != levelled_at &&
+          internal::ResetsADrift(samples, levelled_smooth, key, step, 2 * half + 1) &&
           Seconds(samples[cut].t_ns - samples[key].t_ns) >= kRestAfterResetS) {
         start = std::max(start, key);
         break;

@@ -20,8 +20,8 @@ double LevelStep(const std::vector<double>& curve, size_t key, size_t count);
 /// before it: since the previous key frame the curve moved from its level there by at least
 /// half the step, the other way (a codec's prediction errors piling up until the picture is
 /// renewed), rather than holding a level the key frame changed (a new picture quality).
-/// Medians of `count` frames at each end of that stretch; false without an earlier key frame
-/// `2 count` frames or more before.
+/// Medians of `count` frames at each end of that stretch; false when the nearest earlier key
+/// frame is missing or fewer than `2 count` frames before.
 bool ResetsADrift(const std::vector<HeightSample>& samples, const std::vector<double>& curve,
                   size_t key, double step, size_t count);
 

@@ -536,7 +536,7 @@ TEST(FootTracker, AFewFramesBelowRestAreNoSinking) {
   const auto shown_px = [](double t_s) {
     const double x = t_s - 5.0;
     if (t_s >= 5.0) return x + x * x;
-    return t_s >= 4.0 && t_s < 4.09 ? -1.3 : 0.0;
+    return t_s >= 4.0 - 1e-6 && t_s < 4.09 ? -1.3 : 0.0;
   };
   const Result<FootTrack> track = TrackDrawnRoundFoot(DrawnOptions(cv::Rect(70, 50, 60, 60)), 210,
                                                       shown_px, 14, cv::Point(100, 95));

@@ -173,8 +173,7 @@ TEST(LevelStep, MediansEitherSideOfTheKeyIgnoringUnmeasuredFrames) {
 
 TEST(ResetsADrift, AKeyFrameUndoingItsPredictedFramesDriftButNotANewLevel) {
   // key frames at 0, 20 and 40 (hard3d-07, --seed 21000 --led-on-spread 1: the curve held
-  // 0.55 px from one key frame, crept to 0.84 in three codec steps and fell to 0.3 at the
-  // next)
+  // 0.55 px from one key frame, crept to 0.84 in codec steps and fell to 0.3 at the next)
   std::vector<HeightSample> samples = Samples(60);
   samples[0].keyframe = samples[20].keyframe = samples[40].keyframe = true;
   std::vector<double> drift(60, 0.55);
