@@ -180,17 +180,14 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   const bool set3d = command.set_name == "ci3d" || command.set_name == "hard3d";
-  if (command.rise_slowdown != 1.0 && !set3d) {
-    err << "liftoff synth: --rise-slowdown works with --set ci3d or hard3d\n";
-    return kExitUsage;
-  }
-  if (command.keyframe_interval_frames != 0 && !set3d) {
-    err << "liftoff synth: --keyframe-interval works with --set ci3d or hard3d\n";
-    return kExitUsage;
-  }
-  if (command.led_on_spread_s != 0.0 && !set3d) {
-    err << "liftoff synth: --led-on-spread works with --set ci3d or hard3d\n";
-    return kExitUsage;
+  for (const auto& [flag, given] : {std::pair{"--rise-slowdown", command.rise_slowdown != 1.0},
+                                     std::pair{"--keyframe-interval",
+                                               command.keyframe_interval_frames != 0},
+                                     std::pair{"--led-on-spread", command.led_on_spread_s != 0.0}}) {
+    if (given && !set3d) {
+      err << "liftoff synth: " << flag << " works with --set ci3d or hard3d\n";
+      return kExitUsage;
+    }
   }
   if (set3d || command.set_name == "campaign") {
     return RunSet3d(command, *calibration, out, err);

@@ -846,6 +846,7 @@ struct LiftoffSearch {
   size_t fit_first = 0, fit_last = 0;  // frames fitted
   double max_rise_px = 0;              // of the smoothed curve
   double still_noise_px = 0;           // the rest window's noise, or its key frames' if larger
+  std::vector<double> smooth_px;       // the height's running median (kSmoothHalfS either side)
   std::string not_found;               // why there is no liftoff, when there is none
 };
 
@@ -1010,7 +1011,8 @@ LiftoffSearch FindLiftoff(const std::vector<HeightSample>& samples,
                           double rest_noise_px, bool lossy) {
   LiftoffSearch search;
   const size_t smooth_half = FramesIn(samples, kSmoothHalfS);
-  const std::vector<double> smooth = RunningMedian(height, smooth_half);
+  search.smooth_px = RunningMedian(height, smooth_half);
+  const std::vector<double>& smooth = search.smooth_px;
   for (size_t f = first; f < smooth.size(); ++f) {
     if (std::isfinite(smooth[f])) search.max_rise_px = std::max(search.max_rise_px, smooth[f]);
   }
@@ -1296,19 +1298,18 @@ std::string CheckAgainstTheCurve(const std::vector<HeightSample>& samples,
 // A foot does not sink into the ground: a curve whose running median goes below the rest
 // level by more than kSunkThresholds thresholds before its rise measures more than the foot (a leg
 // tilting as the robot starts to tip, a shadow on the foot's patches). The liftoff is then only
-// known to lie between the curve's last frame within a threshold of rest and the crossing
+// known to lie between its running median's last frame within a threshold of rest and the crossing
 // with its own uncertainty (internal::SunkCrossing): the instant moves to the middle of
 // that interval. Returns why, or "" when the curve did not sink.
-std::string CheckSinking(const std::vector<HeightSample>& samples,
-                         const std::vector<double>& height, const LiftoffSearch& search,
+std::string CheckSinking(const std::vector<HeightSample>& samples, const LiftoffSearch& search,
                          const FootTrack& track, double& crossing_s, double& uncertainty_s) {
   size_t at = search.fit_first;
   while (at < search.fit_last && Seconds(samples[at].t_ns) < crossing_s) ++at;
   const double level = track.rest_rise_px, threshold = track.threshold_px;  // the rest window's
   // on the running median, as the rise is found: no few frames decide
-  const std::vector<double> smooth = RunningMedian(height, FramesIn(samples, kSmoothHalfS));
-  const internal::Sinking sank = internal::SankBefore(samples, smooth, search.fit_first, at, level,
-                                                      threshold, kSunkThresholds * threshold);
+  const internal::Sinking sank =
+      internal::SankBefore(samples, search.smooth_px, search.fit_first, at, level, threshold,
+                           kSunkThresholds * threshold);
   if (!sank.sank) return "";
   const double found_s = crossing_s;
   const internal::Instant between = internal::SunkCrossing(sank.rest_s, found_s, uncertainty_s);
@@ -1425,7 +1426,7 @@ void SetLiftoff(const std::vector<HeightSample>& samples, const PatchSelection& 
   const std::string disagreed =
       CheckAgainstTheCurve(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
   const std::string sank =
-      CheckSinking(samples, selection.height_px, search, track, crossing_s, uncertainty_s);
+      CheckSinking(samples, search, track, crossing_s, uncertainty_s);
   const std::string lost =
       CheckLostRise(samples, selection, search, track, crossing_s, uncertainty_s);
   const std::string few = ReachDownToTheKnee(selection, fit, crossing_s, uncertainty_s);
