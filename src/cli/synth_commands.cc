@@ -105,11 +105,22 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     variation.rise_slowdown = command.rise_slowdown;
     variation.keyframe_interval_frames = command.keyframe_interval_frames;
     variation.led_on_spread_s = command.led_on_spread_s;
+    variation.flicker_amplitude = command.flicker_amplitude;
+    variation.flicker_readout_s =
+        command.flicker_readout_ms < 0 ? -1.0 : 1e-3 * command.flicker_readout_ms;
+    variation.exposure_s = command.exposure_ms < 0 ? -1.0 : 1e-3 * command.exposure_ms;
     const std::string invalid = variation.Validate().message();
     for (const auto& [flag, field] : {std::pair{"--rise-slowdown", "rise_slowdown"},
                                       std::pair{"--keyframe-interval", "keyframe_interval_frames"},
-                                      std::pair{"--led-on-spread", "led_on_spread_s"}}) {
+                                      std::pair{"--led-on-spread", "led_on_spread_s"},
+                                      std::pair{"--flicker", "flicker_amplitude"}}) {
       if (auto named = MessageNamingFlag(invalid, flag, field, false)) {
+        return InvalidArgumentError(*named);
+      }
+    }
+    for (const auto& [flag, field] : {std::pair{"--flicker-readout-ms", "flicker_readout_s"},
+                                      std::pair{"--exposure-ms", "exposure_s"}}) {
+      if (auto named = MessageNamingFlag(invalid, flag, field, true)) {
         return InvalidArgumentError(*named);
       }
     }
@@ -180,10 +191,13 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
   auto calibration = ChooseCalibration(command.calibration);
   if (!calibration.ok()) return ReportError(calibration.status(), err);
   const bool set3d = command.set_name == "ci3d" || command.set_name == "hard3d";
-  for (const auto& [flag, given] : {std::pair{"--rise-slowdown", command.rise_slowdown != 1.0},
-                                     std::pair{"--keyframe-interval",
-                                               command.keyframe_interval_frames != 0},
-                                     std::pair{"--led-on-spread", command.led_on_spread_s != 0.0}}) {
+  for (const auto& [flag, given] :
+       {std::pair{"--rise-slowdown", command.rise_slowdown != 1.0},
+        std::pair{"--keyframe-interval", command.keyframe_interval_frames != 0},
+        std::pair{"--led-on-spread", command.led_on_spread_s != 0.0},
+        std::pair{"--flicker", command.flicker_amplitude >= 0},
+        std::pair{"--flicker-readout-ms", command.flicker_readout_ms >= 0},
+        std::pair{"--exposure-ms", command.exposure_ms >= 0}}) {
     if (given && !set3d) {
       err << "liftoff synth: " << flag << " works with --set ci3d or hard3d\n";
       return kExitUsage;
@@ -228,6 +242,18 @@ Subcommand AddSynthCommand(Command& parent) {
                  "--set ci3d or hard3d: every LED switch-on moved later by a draw from [0, S) "
                  "s seeded by the clip (0 .. 10; 0: as documented, most on a frame's time and "
                  "a key frame)")
+      ->ShowDefault();
+  app->AddOption("--flicker", command->flicker_amplitude,
+                 "--set ci3d or hard3d: every clip's lamp flicker amplitude (0 .. 0.5; it "
+                 "scales the whole picture, the LED too; negative: each clip's own)")
+      ->ShowDefault();
+  app->AddOption("--flicker-readout-ms", command->flicker_readout_ms,
+                 "--set ci3d or hard3d: every clip's readout, ms (0: a global shutter; up to "
+                 "the frame interval: a rolling shutter's bands; negative: each clip's own)")
+      ->ShowDefault();
+  app->AddOption("--exposure-ms", command->exposure_ms,
+                 "--set ci3d or hard3d: every clip's exposure, ms (0 < e <= the frame "
+                 "interval; short ones see a lamp's flicker whole; negative: each clip's own)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

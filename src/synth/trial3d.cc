@@ -989,6 +989,25 @@ Status Set3dVariation::Validate() const {
     return InvalidArgumentError("led_on_spread_s: expected 0 .. 10 s, got " +
                                 FormatNumber(led_on_spread_s));
   }
+  if (!(flicker_amplitude <= 0.5)) {
+    return InvalidArgumentError(
+        "flicker_amplitude: expected 0 .. 0.5 (negative: each clip's "
+        "own), got " +
+        FormatNumber(flicker_amplitude));
+  }
+  // (a readout longer than a clip's frame interval is that clip's error, naming it)
+  if (!(flicker_readout_s <= 1.0)) {
+    return InvalidArgumentError(
+        "flicker_readout_s: expected 0 .. 1/fps s (negative: each "
+        "clip's own), got " +
+        FormatNumber(flicker_readout_s));
+  }
+  if (!(exposure_s <= 1.0) || exposure_s == 0.0) {
+    return InvalidArgumentError(
+        "exposure_s: expected 0 < e <= 1/fps s (negative: each "
+        "clip's own), got " +
+        FormatNumber(exposure_s));
+  }
   VideoWriterOptions writer;
   writer.keyframe_interval_frames = keyframe_interval_frames;
   return writer.Validate();
@@ -1006,6 +1025,9 @@ std::vector<Trial3dSpec> VarySet3d(std::vector<Trial3dSpec> set, const Set3dVari
         variation.led_on_spread_s * SplitMix64(spec.seed ^ kLedOnStream).Uniform();
     spec.led_on_s += shift_s;
     spec.max_duration_s += shift_s;
+    if (variation.flicker_amplitude >= 0) spec.flicker_amplitude = variation.flicker_amplitude;
+    if (variation.flicker_readout_s >= 0) spec.flicker_readout_s = variation.flicker_readout_s;
+    if (variation.exposure_s > 0) spec.exposure_s = variation.exposure_s;
   }
   return set;
 }

@@ -476,6 +476,39 @@ TEST(Trial3d, ALedOnSpreadMovesEachSwitchOnByItsOwnDraw) {
   EXPECT_NE(variation.Validate().message().find("led_on_spread_s"), std::string::npos);
 }
 
+TEST(Trial3d, AFlickerVariationSetsEveryClipsLampReadoutAndExposure) {
+  const std::vector<Trial3dSpec> named = Hard3dSet();
+  // unset: each clip's own (hard3d-01's 35 % through a global shutter, hard3d-09's rolling)
+  const std::vector<Trial3dSpec> own = VarySet3d(named, {});
+  for (size_t i = 0; i < named.size(); ++i) {
+    EXPECT_EQ(own[i].flicker_amplitude, named[i].flicker_amplitude) << named[i].id;
+    EXPECT_EQ(own[i].flicker_readout_s, named[i].flicker_readout_s) << named[i].id;
+  }
+  Set3dVariation variation;
+  variation.flicker_amplitude = 0.5;
+  variation.flicker_readout_s = 0.03;
+  const std::vector<Trial3dSpec> strong = VarySet3d(named, variation);
+  for (size_t i = 0; i < named.size(); ++i) {
+    EXPECT_EQ(strong[i].flicker_amplitude, 0.5) << named[i].id;
+    EXPECT_EQ(strong[i].flicker_readout_s, 0.03) << named[i].id;
+    EXPECT_EQ(strong[i].flicker_hz, named[i].flicker_hz) << named[i].id;
+    EXPECT_EQ(strong[i].exposure_s, named[i].exposure_s) << named[i].id;
+    EXPECT_TRUE(strong[i].Validate().ok()) << named[i].id;
+  }
+  variation.exposure_s = 0.004;
+  for (const Trial3dSpec& spec : VarySet3d(named, variation)) EXPECT_EQ(spec.exposure_s, 0.004);
+  variation.exposure_s = 0.0;
+  EXPECT_NE(variation.Validate().message().find("exposure_s"), std::string::npos);
+  variation.exposure_s = -1.0;
+  variation.flicker_amplitude = 0.6;
+  EXPECT_NE(variation.Validate().message().find("flicker_amplitude"), std::string::npos);
+  variation.flicker_amplitude = 0.5;
+  variation.flicker_readout_s = 0.05;  // longer than a 30 fps frame: the clip's own error
+  EXPECT_TRUE(variation.Validate().ok());
+  EXPECT_NE(VarySet3d(named, variation)[0].Validate().message().find("flicker_readout_s"),
+            std::string::npos);
+}
+
 TEST(Trial3d, LedFractionOfTheCentredExposure) {
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 1.0), 0.5, 1e-12);
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 0.995), 0.75, 1e-12);

@@ -34,6 +34,14 @@ struct SynthCommand {
   /// --led-on-spread: ci3d and hard3d's LED switch-ons each moved later by a seeded draw
   /// from [0, this) s (0 .. 10; synth::Set3dVariation).
   double led_on_spread_s = 0.0;
+  /// --flicker, --flicker-readout-ms: ci3d and hard3d's lamp flicker amplitude (0 .. 0.5)
+  /// and readout (0 .. the frame interval, ms); negative: each clip's own
+  /// (synth::Set3dVariation).
+  double flicker_amplitude = -1.0;
+  double flicker_readout_ms = -1.0;
+  /// --exposure-ms: ci3d and hard3d's exposure (0 < e <= the frame interval, ms); negative:
+  /// each clip's own.
+  double exposure_ms = -1.0;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.

@@ -241,6 +241,16 @@ struct Set3dVariation {
   /// most switch-ons fall on a frame's presentation time and a key frame): the switch-on at
   /// any phase of a frame and between key frames, as a camera started by hand has it.
   double led_on_spread_s = 0.0;
+  /// Every clip's lamp flicker amplitude (Trial3dSpec::flicker_amplitude, 0 .. 0.5) and
+  /// readout, s (Trial3dSpec::flicker_readout_s, 0 .. 1/fps: 0 a global shutter, the whole
+  /// frame one level; more a rolling shutter's bands); negative: each clip's own. Each
+  /// clip keeps its lamp's frequency. Flicker scales the whole picture, the LED's light
+  /// with it; an exposure of many lamp periods averages it away.
+  double flicker_amplitude = -1.0;
+  double flicker_readout_s = -1.0;
+  /// Every clip's exposure, s (Trial3dSpec::exposure_s, 0 < e <= 1/fps; negative: each
+  /// clip's own): short ones see the lamp's flicker whole.
+  double exposure_s = -1.0;
 
   Status Validate() const;
 };
