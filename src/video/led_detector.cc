@@ -121,6 +121,14 @@ constexpr size_t kRowRatioMinCells = 3;
 constexpr double kMinRowGain = 0.05;
 // Rows share their flicker gain in bands of this many.
 constexpr int kGainBandRows = 4;
+// With an ROI the region's signal is read two ways, each a "region" of its own: the
+// changes with the scene's flicker taken out (an LED on its own supply, as on the robot),
+// and the pixels divided by their row's gain (a renderer's or a camera's flicker that
+// scales the LED's light with the picture: strong flicker swings the first reading's lit
+// frames beyond a step's flatness). The first wins wherever it finds the switch-on.
+constexpr int kRoiOwnLight = 0;
+constexpr int kRoiScaledLight = 1;
+constexpr int kRoiSignals = 2;
 // A lit pixel whose brightest channel reaches this level clips (a codec's rounding keeps a
 // clipped pixel within 2 levels of 255) (a partly lit frame then
 // looks brighter than its fraction); such pixels are left out of the dating series unless
@@ -347,7 +355,7 @@ struct LedDetector::Impl {
   int64_t reference_frames = 0;
   size_t top_pixels = 0;
   std::vector<uint8_t> inner;  // per ROI pixel: 1 inside the border band (see kBorderPx)
-  std::vector<float> changes;
+  std::vector<float> changes, scaled_changes;
   std::vector<float> row_gains;  // ring x ROI rows
   std::vector<float> row_ratios;
   std::vector<float> band_gains;
@@ -407,10 +415,8 @@ struct LedDetector::Impl {
 
   uint8_t* RoiPicture(size_t slot);
 
-  // with an ROI, the detection signal: the sum of the top_pixels largest increases of
-  // B + G + R over each pixel's reference (the scene's part scaled by the frame's gain),
-  // plus the top_pixels largest decreases (negative): a light switching on raises it,
-  // switching off lowers it, and however small the light, its pixels are among those
+  // the frame leaving the step window joins each ROI pixel's reference brightness (and the
+  // strips' beside it)
   void FollowReference(const uint8_t* picture, const float* strip);
 
   float* StripSamples(size_t slot) { return &strip_ring[slot * strip_reference.size()]; }
@@ -432,7 +438,14 @@ struct LedDetector::Impl {
   int GainBands() const { return (options.roi_px.height + kGainBandRows - 1) / kGainBandRows; }
   int BandRow(int band) const;
 
-  double MeasureRoi(const cv::Mat& bgr, size_t slot, double gain);
+  // with an ROI, the detection signals (kRoiSignals of them) into `sums`: the sum of the
+  // top_pixels largest increases of B + G + R over each pixel's reference (the scene's part
+  // scaled by its row's gain), plus the top_pixels largest decreases (negative); the same
+  // with each change divided by its row's gain. A light switching on raises them,
+  // switching off lowers them, and however small the light, its pixels are among those
+  void MeasureRoi(const cv::Mat& bgr, size_t slot, double gain, double* sums);
+  // the sum of the top_pixels largest and the top_pixels smallest of `values` (reordered)
+  double ExtremeChanges(std::vector<float>& values) const;
 
   // Whether the pixels that stepped strongly (kRoiStrongFrac of the largest step or more)
   // are a small light, most of them near the largest, that the strong steps the other way
@@ -554,6 +567,9 @@ struct LedDetector::Impl {
   // the LED's region: among the switch-ons with a brightest-channel contrast near the best
   // one, the largest step
   static int ChooseRegion(const std::vector<const StepEvent*>& steps);
+  // with an ROI, the signal whose switch-ons are the LED's: kRoiOwnLight where it has one,
+  // else kRoiScaledLight where that has one; -1 for none
+  static int ChooseRoiSignal(const std::vector<const StepEvent*>& steps);
 
   Result<LedResult> Finish() const;
   // Why no step of `steps` (in the order they happened) is a switch-on seen `where`.
@@ -593,7 +609,7 @@ Status LedDetector::Impl::Setup(const Frame& frame) {
                                   " frame");
     }
     grid = Grid::Make(width_px, height_px, options.cell_px, kReferenceStride);
-    regions = 1;
+    regions = kRoiSignals;
     const auto pixels = static_cast<size_t>(roi.area());
     top_pixels = std::min(pixels, std::max(kTopPixelsMin, pixels / kTopPixelsShare));
     inner = InnerMask(roi.width, roi.height);
@@ -601,6 +617,7 @@ Status LedDetector::Impl::Setup(const Frame& frame) {
     roi_pictures.assign(static_cast<size_t>(ring) * pixels * 3, 0);
     pixel_reference.assign(pixels, 0.0f);
     changes.assign(pixels, 0.0f);
+    scaled_changes.assign(pixels, 0.0f);
     corrected.assign(pixels * static_cast<size_t>(ring), 0.0f);
     pixel_steps.assign(pixels, 0.0);
     channel_steps.assign(pixels, 0.0);
@@ -675,7 +692,7 @@ void LedDetector::Impl::Measure(const Frame& frame, size_t slot) {
   }
   double* sums = &region_sums[slot * static_cast<size_t>(regions)];
   if (!located) {
-    sums[0] = MeasureRoi(frame.bgr, slot, gain);
+    MeasureRoi(frame.bgr, slot, gain, sums);
     return;
   }
   // blocks of 2 x 2 cells
@@ -778,7 +795,7 @@ int LedDetector::Impl::BandRow(int band) const {
   return std::min(band * kGainBandRows + kGainBandRows / 2, options.roi_px.height - 1);
 }
 
-double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gain) {
+void LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gain, double* sums) {
   const cv::Rect& roi = options.roi_px;
   uint8_t* picture = RoiPicture(slot);
   float* strip = StripSamples(slot);
@@ -804,18 +821,26 @@ double LedDetector::Impl::MeasureRoi(const cv::Mat& bgr, size_t slot, double gai
   const auto width = static_cast<size_t>(roi.width);
   const uint8_t* pixel = picture;
   uint64_t total = 0;  // B + G + R over the ROI, for the trace
+  const auto min_gain = static_cast<float>(kMinRowGain);
   for (size_t i = 0; i < changes.size(); ++i, pixel += 3) {
     const int brightness = pixel[0] + pixel[1] + pixel[2];
     total += static_cast<uint64_t>(brightness);
-    changes[i] = inner[i] ? static_cast<float>(brightness) - gains[i / width] * pixel_reference[i]
-                          : 0.0f;
+    const float row_gain = gains[i / width];
+    changes[i] = inner[i] ? static_cast<float>(brightness) - row_gain * pixel_reference[i] : 0.0f;
+    // (a black frame is not divided by)
+    scaled_changes[i] = row_gain >= min_gain ? changes[i] / row_gain : changes[i];
   }
   roi_mean_levels = static_cast<double>(total) / (3.0 * static_cast<double>(changes.size()));
+  sums[kRoiOwnLight] = ExtremeChanges(changes);
+  sums[kRoiScaledLight] = ExtremeChanges(scaled_changes);
+}
+
+double LedDetector::Impl::ExtremeChanges(std::vector<float>& values) const {
   const auto top = static_cast<std::ptrdiff_t>(top_pixels);
-  std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end(), std::greater<>());
-  double signal = std::accumulate(changes.begin(), changes.begin() + top, 0.0);
-  std::nth_element(changes.begin(), changes.begin() + top - 1, changes.end());
-  signal += std::accumulate(changes.begin(), changes.begin() + top, 0.0);
+  std::nth_element(values.begin(), values.begin() + top - 1, values.end(), std::greater<>());
+  double signal = std::accumulate(values.begin(), values.begin() + top, 0.0);
+  std::nth_element(values.begin(), values.begin() + top - 1, values.end());
+  signal += std::accumulate(values.begin(), values.begin() + top, 0.0);
   return signal;
 }
 
@@ -1075,13 +1100,14 @@ void LedDetector::Impl::TestBuildUp() {
     const int64_t first = newest - after_frames - gap + 1;
     const std::optional<WindowShape> shape = BuildUpShape(first, gap, min_step);
     if (!shape) continue;
-    if (!RiseMayStartAt(first, shape->step) || events_per_region[0] >= kMaxEventsPerRegion) {
+    if (!RiseMayStartAt(first, shape->step) ||
+        events_per_region[kRoiOwnLight] >= kMaxEventsPerRegion) {
       return;
     }
     // it stands out from the frame and looks like a light, as a step must, and its first
     // frame is the first lit in the LED's own pixels too
-    const double jump =
-        region_sums[RegionSlot(0, first + 1)] - region_sums[RegionSlot(0, first - 1)];
+    const double jump = region_sums[RegionSlot(kRoiOwnLight, first + 1)] -
+                        region_sums[RegionSlot(kRoiOwnLight, first - 1)];
     if (jump < OutlierJump(first)) return;
     StepEvent event;
     if (!MeasureRoiStep(first, gap, true, event)) return;
@@ -1099,7 +1125,7 @@ void LedDetector::Impl::TestBuildUp() {
       return;
     }
     DropRisesAfter(first);
-    DescribeEvent(0, first, gap, true, *shape, contrast, event);
+    DescribeEvent(kRoiOwnLight, first, gap, true, *shape, contrast, event);
     AddPending(std::move(event));
     return;
   }
@@ -1126,11 +1152,11 @@ std::optional<WindowShape> LedDetector::Impl::FlatShape(int region, int64_t k, i
 std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int gap,
                                                            double min_step) {
   const std::optional<WindowShape> flat_shape =
-      FlatShape(0, first, gap, true, kLitFraction, min_step);
+      FlatShape(kRoiOwnLight, first, gap, true, kLitFraction, min_step);
   if (!flat_shape) return std::nullopt;
   const WindowShape& shape = *flat_shape;
   const double step = shape.step;
-  if (step <= kNoiseFactor * static_cast<double>(region_noise[0])) return std::nullopt;
+  if (step <= kNoiseFactor * static_cast<double>(region_noise[kRoiOwnLight])) return std::nullopt;
   const auto fraction = [&](size_t i) { return (window_values[i] - shape.before_level) / step; };
   const auto before = static_cast<size_t>(kBeforeFrames);
   if (fraction(before - 1) >= kLitFraction) return std::nullopt;
@@ -1141,31 +1167,33 @@ std::optional<WindowShape> LedDetector::Impl::BuildUpShape(int64_t first, int ga
 }
 
 bool LedDetector::Impl::RiseMayStartAt(int64_t first, double step) const {
-  if (level[0] != Level::kHigh || step > kStrongerFactor * static_cast<double>(level_step[0])) {
+  if (level[kRoiOwnLight] != Level::kHigh ||
+      step > kStrongerFactor * static_cast<double>(level_step[kRoiOwnLight])) {
     return true;
   }
   const int64_t first_t_ns = ring_t_ns[Slot(first)];
   return std::any_of(pending.begin(), pending.end(), [&](const StepEvent& event) {
-    return event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
+    return event.region == kRoiOwnLight && event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
   });
 }
 
 void LedDetector::Impl::DropRisesAfter(int64_t first) {
   const int64_t first_t_ns = ring_t_ns[Slot(first)];
   const StepEvent* earliest = nullptr;
+  const auto later_rise = [&](const StepEvent& event) {
+    return event.region == kRoiOwnLight && event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
+  };
   for (const StepEvent& event : pending) {
-    if (event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns &&
+    if (later_rise(event) &&
         (!earliest || event.t_ns[kBeforeFrames] < earliest->t_ns[kBeforeFrames])) {
       earliest = &event;
     }
   }
   if (!earliest) return;
-  level[0] = earliest->level_before;
-  level_step[0] = earliest->level_step_before;
-  const auto dropped = std::remove_if(pending.begin(), pending.end(), [&](const StepEvent& event) {
-    return event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
-  });
-  events_per_region[0] -= static_cast<uint32_t>(std::distance(dropped, pending.end()));
+  level[kRoiOwnLight] = earliest->level_before;
+  level_step[kRoiOwnLight] = earliest->level_step_before;
+  const auto dropped = std::remove_if(pending.begin(), pending.end(), later_rise);
+  events_per_region[kRoiOwnLight] -= static_cast<uint32_t>(std::distance(dropped, pending.end()));
   pending.erase(dropped, pending.end());
 }
 
@@ -1534,6 +1562,14 @@ int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) 
   return best;
 }
 
+int LedDetector::Impl::ChooseRoiSignal(const std::vector<const StepEvent*>& steps) {
+  int best = -1;
+  for (const StepEvent* event : steps) {
+    if (event->rise && (best < 0 || event->region < best)) best = event->region;
+  }
+  return best;
+}
+
 Status LedDetector::Impl::NoSwitchOn(const std::vector<const StepEvent*>& steps,
                                      const std::string& where) const {
   for (const StepEvent* step : steps) {
@@ -1567,7 +1603,7 @@ Result<LedResult> LedDetector::Impl::Finish() const {
   std::sort(steps.begin(), steps.end(), [](const StepEvent* a, const StepEvent* b) {
     return a->index[kBeforeFrames] < b->index[kBeforeFrames];
   });
-  const int best = ChooseRegion(steps);
+  const int best = located ? ChooseRegion(steps) : ChooseRoiSignal(steps);
   if (best < 0) return NoSwitchOn(steps, where);
 
   // the LED's own steps: every pulse of one LED has about the same contrast, so the

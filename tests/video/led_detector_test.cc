@@ -379,17 +379,22 @@ TEST(LedDetector, FindsATinySaturatingLedInABigFlickeringNoisyRegion) {
   EXPECT_FALSE(SaysBuiltUp(*result)) << result->Brief();
 }
 
-// Rolling bands of +-25 % over an LED switching on 40 % into frame 45's exposure (nothing
-// clips, not even at the flicker's brightest): its partly lit frame measured 60 % lit, the
-// instant within a quarter frame.
-void ExpectABandedLedDatedFromItsPartlyLitFrame(bool flicker_scales_led) {
+// Rolling bands of +-amplitude over a dimmed wall and a faint LED switching on 40 % into
+// frame 45's exposure (nothing clips, not even at the flicker's brightest up to +-50 %).
+TinyLedStream BandedStream(double amplitude, bool flicker_scales_led) {
   TinyLedStream stream;
-  stream.flicker_amplitude = 0.25;
+  stream.flicker_amplitude = amplitude;
   stream.flicker_scales_led = flicker_scales_led;
   stream.wall_scale = 0.5;
   stream.light_scale = 0.4;
   stream.noise_sigma = 1.0;
   stream.on_s = 1.5 - 0.5 * stream.exposure_s + 0.4 * stream.exposure_s;
+  return stream;
+}
+
+// Bands of +-25 %: the partly lit frame measured 60 % lit, the instant within a quarter frame.
+void ExpectABandedLedDatedFromItsPartlyLitFrame(bool flicker_scales_led) {
+  const TinyLedStream stream = BandedStream(0.25, flicker_scales_led);
   const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
   ASSERT_TRUE(result);
   EXPECT_NEAR(result->pulses[0].first_lit_fraction, 0.6, 0.05) << result->Brief();
@@ -406,6 +411,24 @@ TEST(LedDetector, ALedTheFlickerScalesWithThePictureIsDatedByItsLightOverTheGain
 // its light with the scene's flicker taken out holds.
 TEST(LedDetector, ALedOnItsOwnSupplyUnderTheSameBandsIsDatedByItsOwnLight) {
   ExpectABandedLedDatedFromItsPartlyLitFrame(false);
+}
+
+// Bands of +-50 % that scale the LED's light with the picture: its lit frames with the
+// scene's flicker taken out swing by half the step either way, beyond any step's flatness,
+// so only its light over its row's gain finds it (`liftoff synth --set hard3d --seed 27000
+// --flicker 0.4 --exposure-ms 2`: 4 of the 9 LEDs found without it, 8 with it).
+TEST(LedDetector, ALedStrongFlickerScalesWithThePictureIsFoundByItsLightOverTheGain) {
+  ASSERT_TRUE(DetectOnePulseAroundTheTruth(BandedStream(0.5, true)));
+}
+
+// The same bands over the same wall with the LED never lit: no switch-on either way.
+TEST(LedDetector, StrongFlickerWithNoLedLitIsNoSwitchOn) {
+  TinyLedStream stream = BandedStream(0.5, true);
+  stream.on_s.reset();
+  const auto result = Detect(DrawTinyLedStream(stream), WithRoi(stream.Roi()));
+  ASSERT_FALSE(result.ok()) << result->Brief();
+  EXPECT_NE(result.status().message().find("never switches on"), std::string::npos)
+      << result.status().ToString();
 }
 
 // A codec that renews the LED's block when the LED lights moves every pixel of that block
