@@ -125,7 +125,8 @@ constexpr int kGainBandRows = 4;
 // changes with the scene's flicker taken out (an LED on its own supply, as on the robot),
 // and the pixels divided by their row's gain (a renderer's or a camera's flicker that
 // scales the LED's light with the picture: strong flicker swings the first reading's lit
-// frames beyond a step's flatness). The first wins wherever it finds the switch-on.
+// frames beyond a step's flatness). The first wins wherever it finds a switch-on of about
+// the best contrast (ChooseRoiSignal).
 constexpr int kRoiOwnLight = 0;
 constexpr int kRoiScaledLight = 1;
 constexpr int kRoiSignals = 2;
@@ -567,8 +568,10 @@ struct LedDetector::Impl {
   // the LED's region: among the switch-ons with a brightest-channel contrast near the best
   // one, the largest step
   static int ChooseRegion(const std::vector<const StepEvent*>& steps);
-  // with an ROI, the signal whose switch-ons are the LED's: kRoiOwnLight where it has one,
-  // else kRoiScaledLight where that has one; -1 for none
+  // with an ROI, the signal whose switch-ons are the LED's: among the switch-ons with a
+  // contrast near the best one (as ChooseRegion), kRoiOwnLight's where it has one, else
+  // kRoiScaledLight's (the moving part that the first reading took for a switch-on under
+  // +-50 % bands had less than half the contrast of the LED only the second found); -1: none
   static int ChooseRoiSignal(const std::vector<const StepEvent*>& steps);
 
   Result<LedResult> Finish() const;
@@ -1563,9 +1566,16 @@ int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) 
 }
 
 int LedDetector::Impl::ChooseRoiSignal(const std::vector<const StepEvent*>& steps) {
+  double best_contrast = 0.0;
+  for (const StepEvent* event : steps) {
+    if (event->rise) best_contrast = std::max(best_contrast, event->contrast_levels);
+  }
   int best = -1;
   for (const StepEvent* event : steps) {
-    if (event->rise && (best < 0 || event->region < best)) best = event->region;
+    if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
+        (best < 0 || event->region < best)) {
+      best = event->region;
+    }
   }
   return best;
 }
