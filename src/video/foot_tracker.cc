@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "patch_registration.h"
 #include "patch_selection.h"
 #include "rise_fit.h"
+#include "row_levels.h"
 #include "video_util.h"
 
 namespace liftoff::video {
@@ -54,6 +56,21 @@ constexpr size_t kRegionPatches = 56;
 constexpr size_t kMarginPatches = 24;
 // Frames averaged into the templates (noise of a single frame would be in every sample).
 constexpr int kTemplateFrames = 4;
+// Rolling bands: each frame's rows are levelled to the templates' (row_levels.h) in a clip
+// whose rows' gains, measured beside the work region (the frame's same rows every
+// kStripStepPx px, up to kStripSpan work regions' widths left and right of it) against the
+// template frames' and smoothed over 2 * kLevelSmoothRows + 1 frame rows, differ by more
+// than kLevelMinRange from row to row in the median of its first kLevelDecideFrames frames
+// after the templates (before that: in each frame whose gains differ so). Mains flicker
+// bands a clip throughout; a frame's noise in low light with shake, or the robot's parts
+// entering the rows beside the region, do not. Samples darker than kLevelMinGrey in the
+// templates are not measured.
+constexpr int kStripStepPx = 8;
+constexpr int kStripSpan = 3;
+constexpr int kLevelSmoothRows = 7;
+constexpr float kLevelMinRange = 0.15f;
+constexpr float kLevelMinGrey = 10.0f;
+constexpr size_t kLevelDecideFrames = 15;
 // A patch whose residual exceeds this multiple of its running typical residual (plus a
 // floor in grey levels) is not measured in that frame; after kLostFrames such frames in a
 // row it is dropped.
@@ -231,6 +248,14 @@ struct FootTracker::Impl {
   double scale = 1;  // work px per frame px
   cv::Rect region_work_px;  // the foot region in work px
   cv::Mat work, accumulated;
+  // the work region's rows beside it (grey: the mean of B, G, R): this frame's every
+  // kStripStepPx px (strip_columns, frame px), and the template frames' mean over the whole
+  // span, which the rows are levelled to (moved as the ground moved)
+  cv::Rect strip_span_px;
+  std::vector<int> strip_columns;
+  cv::Mat strips, span_reference, aligned_reference;
+  std::vector<float> level_ranges;  // the first frames' gain ranges, until `banded` is known
+  std::optional<bool> banded;
   internal::AreaResizer resizer;  // the work region to the work image (scale < 1)
   // the ground around the region as one weighted template, and without a border as the
   // template of the integer search; the last frame's shift of it (work px): a shaken camera
@@ -250,8 +275,17 @@ struct FootTracker::Impl {
 
   void ChooseWorkRegion(const cv::Size& size);
   void MakeWorkImage(const cv::Mat& bgr);
+  // the work region's rows beside it into `strips`; during the template frames also their
+  // whole span into span_reference
+  void SampleStrips(const cv::Mat& bgr);
+  // divides the work image's rows by their gains against the templates' where they are
+  // banded (a rolling shutter's flicker), so that patches see the templates' banding; the
+  // templates' rows moved by the ground's shift since them (work px)
+  void LevelToTheTemplates(const cv::Point2d& shift);
   void InitialisePatches();
-  void MeasurePatches();
+  // every patch registered, from where it was moved as the ground moved (`shift`, work px,
+  // since the templates)
+  void MeasurePatches(const cv::Point2d& shift);
   void AccumulateTemplates(const cv::Mat& bgr);
   void MakeGroundTemplates();
   cv::Point2d GroundShift();
@@ -268,6 +302,13 @@ cv::Rect WorkRegion(const cv::Rect& roi, const cv::Size& size) {
   const int margin_y = static_cast<int>(std::lround(kMarginFraction * roi.height));
   return cv::Rect(roi.x - margin_x, roi.y - margin_y, roi.width + 2 * margin_x,
                   roi.height + 2 * margin_y) &
+         cv::Rect(0, 0, size.width, size.height);
+}
+
+// the work region's rows, kStripSpan of its widths either side of it, inside the frame
+cv::Rect StripRegion(const cv::Rect& work, const cv::Size& size) {
+  const int span = kStripSpan * work.width;
+  return cv::Rect(work.x - span, work.y, work.width + 2 * span, work.height) &
          cv::Rect(0, 0, size.width, size.height);
 }
 
@@ -361,6 +402,7 @@ void FootTracker::Impl::AccumulateTemplates(const cv::Mat& bgr) {
   }
   if (++accumulated_frames < kTemplateFrames) return;
   work = accumulated / kTemplateFrames;
+  span_reference /= kTemplateFrames;
   InitialisePatches();
   MakeGroundTemplates();
   global_shift_px = cv::Point2d(0, 0);
@@ -423,10 +465,76 @@ cv::Point2d FootTracker::Impl::GroundShift() {
   return shift;
 }
 
-void FootTracker::Impl::MeasurePatches() {
+void FootTracker::Impl::SampleStrips(const cv::Mat& bgr) {
+  if (strip_span_px.empty()) {
+    strip_span_px = StripRegion(work_px, frame_size);
+    const cv::Rect& span = strip_span_px;
+    for (int x = span.x + kStripStepPx / 2; x < span.x + span.width; x += kStripStepPx) {
+      if (x < work_px.x - kStripStepPx || x >= work_px.x + work_px.width + kStripStepPx) {
+        strip_columns.push_back(x);
+      }
+    }
+    span_reference = cv::Mat::zeros(strip_span_px.size(), CV_32F);
+  }
+  if (!initialised) {  // a template frame: its whole span
+    for (int y = 0; y < strip_span_px.height; ++y) {
+      const uint8_t* pixel = bgr.ptr<uint8_t>(strip_span_px.y + y) + 3 * strip_span_px.x;
+      float* out = span_reference.ptr<float>(y);
+      for (int x = 0; x < strip_span_px.width; ++x, pixel += 3) {
+        out[x] += static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / 3.0f;
+      }
+    }
+  }
+  strips.create(work_px.height, std::max<int>(1, static_cast<int>(strip_columns.size())), CV_32F);
+  strips.setTo(0.0f);
+  for (int y = 0; y < work_px.height; ++y) {
+    const uint8_t* row = bgr.ptr<uint8_t>(work_px.y + y);
+    float* out = strips.ptr<float>(y);
+    for (size_t s = 0; s < strip_columns.size(); ++s) {
+      const uint8_t* pixel = row + 3 * strip_columns[s];
+      out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / 3.0f;
+    }
+  }
+}
+
+void FootTracker::Impl::LevelToTheTemplates(const cv::Point2d& shift) {
+  if (strip_columns.empty()) return;
+  // the templates' pixels where this frame's are now (a shaken camera moves them)
+  const auto moved_x = static_cast<int>(std::lround(shift.x / scale));
+  const auto moved_y = static_cast<int>(std::lround(shift.y / scale));
+  aligned_reference.create(strips.size(), CV_32F);
+  for (int y = 0; y < strips.rows; ++y) {
+    const float* from = span_reference.ptr<float>(std::clamp(y - moved_y, 0, strips.rows - 1));
+    float* out = aligned_reference.ptr<float>(y);
+    for (size_t s = 0; s < strip_columns.size(); ++s) {
+      const int x =
+          std::clamp(strip_columns[s] - moved_x - strip_span_px.x, 0, strip_span_px.width - 1);
+      out[s] = from[x];
+    }
+  }
+  const std::vector<float> frame_gains =
+      internal::RowGains(strips, aligned_reference, kLevelSmoothRows, kLevelMinGrey);
+  if (frame_gains.empty()) return;
+  // the work image's rows: the frame row each shows
+  std::vector<float> gains(static_cast<size_t>(work.rows));
+  for (int y = 0; y < work.rows; ++y) {
+    const auto row = static_cast<int>(std::lround((y + 0.5) / scale - 0.5));
+    gains[static_cast<size_t>(y)] =
+        frame_gains[static_cast<size_t>(std::clamp(row, 0, work_px.height - 1))];
+  }
+  const float range = internal::GainRange(gains);
+  if (!banded) {
+    level_ranges.push_back(range);
+    if (level_ranges.size() >= kLevelDecideFrames) {
+      banded = MedianOf(level_ranges) > kLevelMinRange;
+    }
+  }
+  if (banded ? *banded : range > kLevelMinRange) internal::LevelRows(work, gains);
+}
+
+void FootTracker::Impl::MeasurePatches(const cv::Point2d& shift) {
   // each patch starts from where it was, moved as much as the ground moved since the last
   // frame
-  const cv::Point2d shift = GroundShift();
   const cv::Point2d moved = shift - global_shift_px;
   global_shift_px = shift;
   for (TrackedPatch& patch : patches) {
@@ -469,7 +577,7 @@ FootTracker::~FootTracker() = default;
 const std::vector<HeightSample>& FootTracker::samples() const { return impl_->samples; }
 
 cv::Rect FootTracker::RegionRead(cv::Size frame_px) const {
-  return WorkRegion(impl_->options.foot_roi_px, frame_px);
+  return StripRegion(WorkRegion(impl_->options.foot_roi_px, frame_px), frame_px);
 }
 
 void FootTracker::SetRestWindow(int64_t rest_from_ns, int64_t rest_to_ns) {
@@ -511,9 +619,13 @@ Status FootTracker::Process(const Frame& frame) {
   }
   try {
     s.MakeWorkImage(bgr);
+    s.SampleStrips(bgr);
     if (!s.initialised) s.AccumulateTemplates(bgr);
     if (s.initialised) {
-      s.MeasurePatches();
+      // levelled first (against the templates moved by the last frame's shift), so that the
+      // ground is registered on a levelled picture too
+      s.LevelToTheTemplates(s.global_shift_px);
+      s.MeasurePatches(s.GroundShift());
     } else {
       s.measured_from = s.samples.size() + 1;
     }

@@ -194,7 +194,8 @@ class FootTracker {
   /// patches (bench/video_bench prints the cost).
   Status Process(const Frame& frame);
   /// The part of a `frame_px` frame that Process reads: the foot region with a margin
-  /// around it. A reader need convert only this (VideoReader::ConvertOnly).
+  /// around it, and its rows three times its width either side (they measure a rolling
+  /// shutter's flicker bands). A reader need convert only this (VideoReader::ConvertOnly).
   cv::Rect RegionRead(cv::Size frame_px) const;
   /// Sets the rest window after the fact (the LED instant is known only at the end of a
   /// single pass); overrides Options::rest_from_ns/rest_to_ns.
