@@ -421,6 +421,17 @@ TEST(LedDetector, ALedStrongFlickerScalesWithThePictureIsFoundByItsLightOverTheG
   ASSERT_TRUE(DetectOnePulseAroundTheTruth(BandedStream(0.5, true)));
 }
 
+// The same, and a glint on its own light (3 px, 28 levels) that came 25 frames before the
+// LED: the first reading finds the glint and not the LED, the second the LED, far brighter,
+// which wins (with the first reading's switch-on preferred whatever its contrast, the glint
+// was the LED, 25 frames early).
+TEST(LedDetector, UnderStrongFlickerAFaintRiseOfTheFirstReadingLosesToTheLed) {
+  TinyLedStream stream = BandedStream(0.5, true);
+  stream.glint_from_frame = 20;
+  stream.glint_levels = 28.0;
+  ASSERT_TRUE(DetectOnePulseAroundTheTruth(stream));
+}
+
 // The same bands over the same wall with the LED never lit: no switch-on either way.
 TEST(LedDetector, StrongFlickerWithNoLedLitIsNoSwitchOn) {
   TinyLedStream stream = BandedStream(0.5, true);
