@@ -944,6 +944,9 @@ Result<Set3dSummary> WriteSpecs3d(const std::string& name, const std::vector<Tri
   const int64_t started_ns = MonotonicNowNs();
   // absolute, so that the manifest's paths come out relative to its own folder
   const std::filesystem::path output_dir = std::filesystem::absolute(output_folder);
+  // every clip's spec first: a bad one (a varied set's exposure longer than a 60 fps clip's
+  // frame) fails before anything is rendered or written
+  for (const Trial3dSpec& spec : set) LIFTOFF_RETURN_IF_ERROR(spec.Validate().WithContext(spec.id));
   LIFTOFF_ASSIGN_OR_RETURN(std::unique_ptr<EglContext> context, EglContext::Create());
   Set3dSummary summary;
   summary.name = name;
@@ -1051,6 +1054,15 @@ Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::
   }
   if (variation.led_on_spread_s != 0.0) {
     varied += ", the LED switch-on up to " + FormatNumber(variation.led_on_spread_s) + " s later";
+  }
+  if (variation.flicker_amplitude >= 0) {
+    varied += ", lamp flicker " + FormatNumber(variation.flicker_amplitude);
+  }
+  if (variation.flicker_readout_s >= 0) {
+    varied += ", readout " + FormatNumber(1e3 * variation.flicker_readout_s) + " ms";
+  }
+  if (variation.exposure_s > 0) {
+    varied += ", exposure " + FormatNumber(1e3 * variation.exposure_s) + " ms";
   }
   const std::string description =
       varied.empty() ? "" : "liftoff synth set " + name + " (" + calibration.name + ")" + varied;

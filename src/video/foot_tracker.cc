@@ -67,6 +67,10 @@ constexpr int kTemplateFrames = 4;
 // templates are not measured.
 constexpr int kStripStepPx = 8;
 constexpr int kStripSpan = 3;
+// Fewer columns beside the region than this (a region as wide as the frame) measure no
+// bands; a row gain under kMinLevelGain (a black frame) is not divided by.
+constexpr size_t kStripMinColumns = 8;
+constexpr float kMinLevelGain = 0.05f;
 constexpr int kLevelSmoothRows = 7;
 constexpr float kLevelMinRange = 0.15f;
 constexpr float kLevelMinGrey = 10.0f;
@@ -474,6 +478,7 @@ void FootTracker::Impl::SampleStrips(const cv::Mat& bgr) {
         strip_columns.push_back(x);
       }
     }
+    if (strip_columns.size() < kStripMinColumns) strip_columns.clear();
     span_reference = cv::Mat::zeros(strip_span_px.size(), CV_32F);
   }
   if (!initialised) {  // a template frame: its whole span
@@ -529,7 +534,8 @@ void FootTracker::Impl::LevelToTheTemplates(const cv::Point2d& shift) {
       banded = MedianOf(level_ranges) > kLevelMinRange;
     }
   }
-  if (banded ? *banded : range > kLevelMinRange) internal::LevelRows(work, gains);
+  const bool usable = *std::min_element(gains.begin(), gains.end()) >= kMinLevelGain;
+  if (usable && (banded ? *banded : range > kLevelMinRange)) internal::LevelRows(work, gains);
 }
 
 void FootTracker::Impl::MeasurePatches(const cv::Point2d& shift) {

@@ -311,6 +311,8 @@ const std::vector<HostileCase>& Cases() {
        {"hard3d-01", "flicker_readout_s", "0.05"}},
       {"synth --exposure-ms of zero", nullptr, "synth --set ci3d --exposure-ms 0 -o @/set -q", 3,
        {"--exposure-ms", "exposure_s"}},
+      {"synth --exposure-ms longer than a 60 fps clip's frame", nullptr,
+       "synth --set ci3d --exposure-ms 20 -o @/set -q", 3, {"ci3d-05", "exposure_s", "0.02"}},
       {"sim sweep --hardware of a missing manifest", nullptr,
        "sim sweep --hardware @/missing.json --progress off", 4, {"--hardware", "missing.json"},
        {"s wall"}},  // failed before the sweep, not after it
