@@ -110,17 +110,18 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
         command.flicker_readout_ms < 0 ? -1.0 : 1e-3 * command.flicker_readout_ms;
     variation.exposure_s = command.exposure_ms < 0 ? -1.0 : 1e-3 * command.exposure_ms;
     const std::string invalid = variation.Validate().message();
-    for (const auto& [flag, field] : {std::pair{"--rise-slowdown", "rise_slowdown"},
-                                      std::pair{"--keyframe-interval", "keyframe_interval_frames"},
-                                      std::pair{"--led-on-spread", "led_on_spread_s"},
-                                      std::pair{"--flicker", "flicker_amplitude"}}) {
-      if (auto named = MessageNamingFlag(invalid, flag, field, false)) {
-        return InvalidArgumentError(*named);
-      }
-    }
-    for (const auto& [flag, field] : {std::pair{"--flicker-readout-ms", "flicker_readout_s"},
-                                      std::pair{"--exposure-ms", "exposure_s"}}) {
-      if (auto named = MessageNamingFlag(invalid, flag, field, true)) {
+    struct FlagField {
+      const char* flag;
+      const char* field;
+      bool scaled;  // the flag's unit differs from the field's (ms against s)
+    };
+    for (const FlagField& f : {FlagField{"--rise-slowdown", "rise_slowdown", false},
+                               FlagField{"--keyframe-interval", "keyframe_interval_frames", false},
+                               FlagField{"--led-on-spread", "led_on_spread_s", false},
+                               FlagField{"--flicker", "flicker_amplitude", false},
+                               FlagField{"--flicker-readout-ms", "flicker_readout_s", true},
+                               FlagField{"--exposure-ms", "exposure_s", true}}) {
+      if (auto named = MessageNamingFlag(invalid, f.flag, f.field, f.scaled)) {
         return InvalidArgumentError(*named);
       }
     }

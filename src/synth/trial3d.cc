@@ -994,21 +994,18 @@ Status Set3dVariation::Validate() const {
   }
   if (!(flicker_amplitude <= 0.5)) {
     return InvalidArgumentError(
-        "flicker_amplitude: expected 0 .. 0.5 (negative: each clip's "
-        "own), got " +
+        "flicker_amplitude: expected 0 .. 0.5 (negative: each clip's own), got " +
         FormatNumber(flicker_amplitude));
   }
   // (a readout longer than a clip's frame interval is that clip's error, naming it)
   if (!(flicker_readout_s <= 1.0)) {
     return InvalidArgumentError(
-        "flicker_readout_s: expected 0 .. 1/fps s (negative: each "
-        "clip's own), got " +
+        "flicker_readout_s: expected 0 .. 1/fps s (negative: each clip's own), got " +
         FormatNumber(flicker_readout_s));
   }
   if (!(exposure_s <= 1.0) || exposure_s == 0.0) {
     return InvalidArgumentError(
-        "exposure_s: expected 0 < e <= 1/fps s (negative: each "
-        "clip's own), got " +
+        "exposure_s: expected 0 < e <= 1/fps s (negative: each clip's own), got " +
         FormatNumber(exposure_s));
   }
   VideoWriterOptions writer;

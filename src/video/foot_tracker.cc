@@ -309,6 +309,9 @@ cv::Rect WorkRegion(const cv::Rect& roi, const cv::Size& size) {
          cv::Rect(0, 0, size.width, size.height);
 }
 
+// a pixel's grey level for the strips: the mean of B, G and R
+float MeanGrey(const uint8_t* bgr) { return static_cast<float>(bgr[0] + bgr[1] + bgr[2]) / 3.0f; }
+
 // the work region's rows, kStripSpan of its widths either side of it, inside the frame
 cv::Rect StripRegion(const cv::Rect& work, const cv::Size& size) {
   const int span = kStripSpan * work.width;
@@ -481,29 +484,25 @@ void FootTracker::Impl::SampleStrips(const cv::Mat& bgr) {
     if (strip_columns.size() < kStripMinColumns) strip_columns.clear();
     span_reference = cv::Mat::zeros(strip_span_px.size(), CV_32F);
   }
+  // nothing to measure: no columns, or a clip found not banded
+  if (strip_columns.empty() || (banded && !*banded)) return;
   if (!initialised) {  // a template frame: its whole span
     for (int y = 0; y < strip_span_px.height; ++y) {
       const uint8_t* pixel = bgr.ptr<uint8_t>(strip_span_px.y + y) + 3 * strip_span_px.x;
       float* out = span_reference.ptr<float>(y);
-      for (int x = 0; x < strip_span_px.width; ++x, pixel += 3) {
-        out[x] += static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / 3.0f;
-      }
+      for (int x = 0; x < strip_span_px.width; ++x, pixel += 3) out[x] += MeanGrey(pixel);
     }
   }
-  strips.create(work_px.height, std::max<int>(1, static_cast<int>(strip_columns.size())), CV_32F);
-  strips.setTo(0.0f);
+  strips.create(work_px.height, static_cast<int>(strip_columns.size()), CV_32F);
   for (int y = 0; y < work_px.height; ++y) {
     const uint8_t* row = bgr.ptr<uint8_t>(work_px.y + y);
     float* out = strips.ptr<float>(y);
-    for (size_t s = 0; s < strip_columns.size(); ++s) {
-      const uint8_t* pixel = row + 3 * strip_columns[s];
-      out[s] = static_cast<float>(pixel[0] + pixel[1] + pixel[2]) / 3.0f;
-    }
+    for (size_t s = 0; s < strip_columns.size(); ++s) out[s] = MeanGrey(row + 3 * strip_columns[s]);
   }
 }
 
 void FootTracker::Impl::LevelToTheTemplates(const cv::Point2d& shift) {
-  if (strip_columns.empty()) return;
+  if (strip_columns.empty() || (banded && !*banded)) return;
   // the templates' pixels where this frame's are now (a shaken camera moves them)
   const auto moved_x = static_cast<int>(std::lround(shift.x / scale));
   const auto moved_y = static_cast<int>(std::lround(shift.y / scale));

@@ -1548,16 +1548,26 @@ cv::Rect LedDetector::Impl::LocatedRect(const StepEvent& event) const {
   return rect;
 }
 
-int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) {
+namespace {
+
+// the contrast a switch-on of `steps` needs to be near the best one's: kEligibleContrastFrac
+// of the largest
+double EligibleContrast(const std::vector<const StepEvent*>& steps) {
   double best_contrast = 0.0;
-  for (const StepEvent* event : steps) {
-    if (event->rise) best_contrast = std::max(best_contrast, event->contrast_levels);
+  for (const StepEvent* step : steps) {
+    if (step->rise) best_contrast = std::max(best_contrast, step->contrast_levels);
   }
+  return kEligibleContrastFrac * best_contrast;
+}
+
+}  // namespace
+
+int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) {
+  const double eligible = EligibleContrast(steps);
   int best = -1;
   double best_step = 0.0;
   for (const StepEvent* event : steps) {
-    if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
-        event->signal_step > best_step) {
+    if (event->rise && event->contrast_levels >= eligible && event->signal_step > best_step) {
       best_step = event->signal_step;
       best = event->region;
     }
@@ -1566,14 +1576,10 @@ int LedDetector::Impl::ChooseRegion(const std::vector<const StepEvent*>& steps) 
 }
 
 int LedDetector::Impl::ChooseRoiSignal(const std::vector<const StepEvent*>& steps) {
-  double best_contrast = 0.0;
-  for (const StepEvent* event : steps) {
-    if (event->rise) best_contrast = std::max(best_contrast, event->contrast_levels);
-  }
+  const double eligible = EligibleContrast(steps);
   int best = -1;
   for (const StepEvent* event : steps) {
-    if (event->rise && event->contrast_levels >= kEligibleContrastFrac * best_contrast &&
-        (best < 0 || event->region < best)) {
+    if (event->rise && event->contrast_levels >= eligible && (best < 0 || event->region < best)) {
       best = event->region;
     }
   }
