@@ -109,18 +109,20 @@ Result<synth::Set3dSummary> WriteNamedSet3d(const SynthCommand& command,
     variation.flicker_readout_s =
         command.flicker_readout_ms < 0 ? -1.0 : 1e-3 * command.flicker_readout_ms;
     variation.exposure_s = command.exposure_ms < 0 ? -1.0 : 1e-3 * command.exposure_ms;
+    variation.led_radius_m = command.led_radius_mm < 0 ? -1.0 : 1e-3 * command.led_radius_mm;
     const std::string invalid = variation.Validate().message();
     struct FlagField {
       const char* flag;
       const char* field;
-      bool scaled;  // the flag's unit differs from the field's (ms against s)
+      bool scaled;  // the flag's unit differs from the field's (ms against s, mm against m)
     };
     for (const FlagField& f : {FlagField{"--rise-slowdown", "rise_slowdown", false},
                                FlagField{"--keyframe-interval", "keyframe_interval_frames", false},
                                FlagField{"--led-on-spread", "led_on_spread_s", false},
                                FlagField{"--flicker", "flicker_amplitude", false},
                                FlagField{"--flicker-readout-ms", "flicker_readout_s", true},
-                               FlagField{"--exposure-ms", "exposure_s", true}}) {
+                               FlagField{"--exposure-ms", "exposure_s", true},
+                               FlagField{"--led-radius-mm", "led_radius_m", true}}) {
       if (auto named = MessageNamingFlag(invalid, f.flag, f.field, f.scaled)) {
         return InvalidArgumentError(*named);
       }
@@ -198,7 +200,8 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
         std::pair{"--led-on-spread", command.led_on_spread_s != 0.0},
         std::pair{"--flicker", command.flicker_amplitude >= 0},
         std::pair{"--flicker-readout-ms", command.flicker_readout_ms >= 0},
-        std::pair{"--exposure-ms", command.exposure_ms >= 0}}) {
+        std::pair{"--exposure-ms", command.exposure_ms >= 0},
+        std::pair{"--led-radius-mm", command.led_radius_mm >= 0}}) {
     if (given && !set3d) {
       err << "liftoff synth: " << flag << " works with --set ci3d or hard3d\n";
       return kExitUsage;
@@ -255,6 +258,10 @@ Subcommand AddSynthCommand(Command& parent) {
   app->AddOption("--exposure-ms", command->exposure_ms,
                  "--set ci3d or hard3d: every clip's exposure, ms (0 < e <= the frame "
                  "interval; short ones see a lamp's flicker whole; negative: each clip's own)")
+      ->ShowDefault();
+  app->AddOption("--led-radius-mm", command->led_radius_mm,
+                 "--set ci3d or hard3d: every clip's LED radius, mm (1 .. 20; hard3d-06's 1.5 "
+                 "mm is 0.59 px; negative: each clip's own)")
       ->ShowDefault();
   app->AddOption("--output,-o", command->output_dir, "Folder for the files");
   app->AddSwitch("--print-spec", command->print_spec, "Print the default spec as JSON");

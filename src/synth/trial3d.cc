@@ -1008,6 +1008,11 @@ Status Set3dVariation::Validate() const {
         "exposure_s: expected 0 < e <= 1/fps s (negative: each clip's own), got " +
         FormatNumber(exposure_s));
   }
+  if (!(led_radius_m <= 0.02) || (led_radius_m >= 0.0 && led_radius_m < 0.001)) {
+    return InvalidArgumentError(
+        "led_radius_m: expected 0.001 .. 0.02 m (negative: each clip's own), got " +
+        FormatNumber(led_radius_m));
+  }
   VideoWriterOptions writer;
   writer.keyframe_interval_frames = keyframe_interval_frames;
   return writer.Validate();
@@ -1028,6 +1033,7 @@ std::vector<Trial3dSpec> VarySet3d(std::vector<Trial3dSpec> set, const Set3dVari
     if (variation.flicker_amplitude >= 0) spec.flicker_amplitude = variation.flicker_amplitude;
     if (variation.flicker_readout_s >= 0) spec.flicker_readout_s = variation.flicker_readout_s;
     if (variation.exposure_s > 0) spec.exposure_s = variation.exposure_s;
+    if (variation.led_radius_m >= 0) spec.scene.led_radius_m = variation.led_radius_m;
   }
   return set;
 }
@@ -1060,6 +1066,9 @@ Result<Set3dSummary> WriteSet3d(const std::string& name, const std::filesystem::
   }
   if (variation.exposure_s > 0) {
     varied += ", exposure " + FormatNumber(1e3 * variation.exposure_s) + " ms";
+  }
+  if (variation.led_radius_m >= 0) {
+    varied += ", LED radius " + FormatNumber(1e3 * variation.led_radius_m) + " mm";
   }
   const std::string description =
       varied.empty() ? "" : "liftoff synth set " + name + " (" + calibration.name + ")" + varied;

@@ -509,6 +509,24 @@ TEST(Trial3d, AFlickerVariationSetsEveryClipsLampReadoutAndExposure) {
             std::string::npos);
 }
 
+TEST(Trial3d, AnLedRadiusVariationSetsEveryClipsLed) {
+  const std::vector<Trial3dSpec> named = Hard3dSet();
+  const std::vector<Trial3dSpec> own = VarySet3d(named, {});
+  for (size_t i = 0; i < named.size(); ++i) {
+    EXPECT_EQ(own[i].scene.led_radius_m, named[i].scene.led_radius_m) << named[i].id;
+  }
+  Set3dVariation variation;
+  variation.led_radius_m = 0.002;
+  for (const Trial3dSpec& spec : VarySet3d(named, variation)) {
+    EXPECT_EQ(spec.scene.led_radius_m, 0.002) << spec.id;
+    EXPECT_TRUE(spec.Validate().ok()) << spec.id;
+  }
+  for (const double radius_m : {0.0005, 0.03}) {
+    variation.led_radius_m = radius_m;
+    EXPECT_NE(variation.Validate().message().find("led_radius_m"), std::string::npos) << radius_m;
+  }
+}
+
 TEST(Trial3d, LedFractionOfTheCentredExposure) {
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 1.0), 0.5, 1e-12);
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 0.995), 0.75, 1e-12);

@@ -42,6 +42,8 @@ struct SynthCommand {
   /// --exposure-ms: ci3d and hard3d's exposure (0 < e <= the frame interval, ms); negative:
   /// each clip's own.
   double exposure_ms = -1.0;
+  /// --led-radius-mm: ci3d and hard3d's LED radius (1 .. 20 mm); negative: each clip's own.
+  double led_radius_mm = -1.0;
   /// Folder the files go to (created when missing).
   std::filesystem::path output_dir;
   /// Print the default TrialSpec as JSON on `out` and do nothing else.

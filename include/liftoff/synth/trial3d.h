@@ -251,6 +251,9 @@ struct Set3dVariation {
   /// Every clip's exposure, s (Trial3dSpec::exposure_s, 0 < e <= 1/fps; negative: each
   /// clip's own): short ones see the lamp's flicker whole.
   double exposure_s = -1.0;
+  /// Every clip's LED radius, m (Scene3dOptions::led_radius_m, 0.001 .. 0.02; negative:
+  /// each clip's own): how small an LED the detector meets.
+  double led_radius_m = -1.0;
 
   Status Validate() const;
 };
