@@ -144,6 +144,9 @@ constexpr double kFlatFracPixels = 0.2;
 // hard3d-06's half-lit frame, --seed 6000, 57 % of the step in its pixels, and the frame
 // before it was not yet a step).
 constexpr double kPartlyLitBeforeFrac = 0.75;
+// A dim step (under dim_warning_levels) through a lossy codec: a frame's lit fraction is
+// known to within this either way.
+constexpr double kDimCodecFrac = 0.5;
 // The frames after a step may go on in its direction by at most this fraction of it (a
 // codec refines a small bright spot over a few frames), during its confirmation too.
 constexpr double kCreepFrac = 0.5;
@@ -1449,15 +1452,17 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
   const auto fraction = [&](size_t i) { return (event.value[i] - event.off) / scale; };
   // what the partly lit frame saw: its fraction within the noise band; when the LED's
   // pixels clip, a partly lit frame looks brighter than it was, so only the upper bound
-  // holds; so too for a dim step (a lossy codec copies or drops a step of a few grey
-  // levels whole: a half-lit frame of hard3d-06's 0.6 px LED, 9 levels, is as lit as the
-  // next)
-  const bool only_upper = event.clipped || event.contrast_levels < options.dim_warning_levels;
+  // holds. A dim step through a lossy codec moves each frame's fraction by up to
+  // kDimCodecFrac either way (a codec copies or drops a step of a few grey levels whole: a
+  // half-lit frame of hard3d-06's 0.6 px LED, 9 levels, is as lit as the next; another,
+  // --seed 1000, as dark as the one before)
+  const bool dim = !event.clipped && event.contrast_levels < options.dim_warning_levels;
+  const double shift = dim ? kDimCodecFrac : band;
   const auto lit_band = [&](double f) {
-    return LitFraction{only_upper ? 0.0 : std::max(0.0, f - band - event.creep),
-                       std::min(1.0, f + band)};
+    return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - shift - event.creep),
+                       std::min(1.0, f + shift)};
   };
-  const LitFraction dark{0.0, lit_above};
+  const LitFraction dark{0.0, dim ? std::max(lit_above, kDimCodecFrac) : lit_above};
   const size_t count = event.value.size();
   LedPulse pulse;
   if (event.rise) {
@@ -1496,6 +1501,20 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
           whole ? LitFraction{1.0 - band, 1.0} : LitFraction{0.0, 1.0}, exposure);
       dating.surely = {std::min(dating.surely.low_ns, spread.low_ns),
                        std::max(dating.surely.high_ns, spread.high_ns)};
+      // dated where the spread frames cross half lit, not by the first to pass the
+      // threshold (a build-up's frame lit 49 % is the switch-on's own), of the furthest
+      // level the frames after reach (a build-up may still creep on)
+      const double whole_level = *std::max_element(
+          event.value.begin() + static_cast<std::ptrdiff_t>(first_whole), event.value.end());
+      const auto of_whole = [&](size_t i) {
+        return (event.value[i] - event.off) / std::max(whole_level - event.off, scale);
+      };
+      size_t above = first_partial;
+      while (above < first_whole && of_whole(above) < 0.5) ++above;
+      dating.estimate_ns = std::clamp(
+          internal::HalfLitInstant(static_cast<double>(event.t_ns[above - 1]), of_whole(above - 1),
+                                   static_cast<double>(event.t_ns[above]), of_whole(above)),
+          dating.surely.low_ns, dating.surely.high_ns);
       pulse.first_lit_frame = event.index[first_partial];
       pulse.first_lit_fraction = std::clamp(fraction(first_partial), 0.0, 1.0);
     }

@@ -134,6 +134,20 @@ inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_
   return dating;
 }
 
+// A switch-on that a codec spread over several frames in a row, each lit part way (H.264's
+// B-frames blend the step into their neighbours; a small light is built up over frames):
+// the instant at which the lit fraction crosses one half, linear between the frame before
+// the crossing (t_below_ns, lit f_below < 1/2) and the one at or above it (t_above_ns,
+// f_above >= 1/2). A frame lit half its exposure is centred on the switch-on whatever the
+// exposure (s = t + E (1/2 - f)), and a blend spreads the step about evenly either side
+// of it, so the crossing does not depend on which of the spread frames first passes a
+// threshold. Fractions outside that order give the nearer frame's timestamp.
+inline double HalfLitInstant(double t_below_ns, double f_below, double t_above_ns, double f_above) {
+  if (!(f_above > f_below)) return f_above >= 0.5 ? t_above_ns : t_below_ns;
+  const double along = std::clamp((0.5 - f_below) / (f_above - f_below), 0.0, 1.0);
+  return t_below_ns + along * (t_above_ns - t_below_ns);
+}
+
 // The switch-off instants consistent with frame `lit` (t_lit_ns, lit fraction in
 // [lit.low, lit.high]) and the next frame `dark` (t_dark_ns > t_lit_ns, lit fraction in
 // [0, dark.high]): the switch-on problem with time reversed (a centred exposure is

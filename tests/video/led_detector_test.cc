@@ -516,8 +516,9 @@ TEST(LedDetector, AFaintLedACodecBuildsUpOverFramesIsFound) {
 // H.264's B-frames blend a faint tiny LED's step between their reference frames (hard3d-06
 // with --seed 20000 --keyframe-interval 250 --led-on-spread 1: P-frame 87 dark, B-frames 88
 // and 89 at 0.29 and 0.68 of the step, P-frame 90 whole; 88 was half lit). Two frames in a
-// row lit part way is no switch-on's: the frame after the half-lit one is dated, a frame
-// late, but its interval reaches from the last dark frame to the first whole one and says so.
+// row lit part way is no switch-on's: it is dated where the two cross half lit (here half a
+// frame late: the blend put more of the step after the switch-on than before), and its
+// interval reaches from the last dark frame to the first whole one and says so.
 TEST(LedDetector, AStepACodecBlendsOverTwoFramesWidensItsIntervalOverBoth) {
   TinyLedStream stream = FrozenFaintLed({0.66, 0.67});
   const double t45_ns = 45 * stream.PeriodNs();
@@ -544,6 +545,21 @@ TEST(LedDetector, AStepACodecBlendsOverTwoFramesWidensItsIntervalOverBoth) {
   const std::optional<LedResult> plain = DetectOnePulseAroundTheTruth(FrozenFaintLed({}));
   ASSERT_TRUE(plain);
   EXPECT_LE(plain->pulses[0].spread_frames, 1) << plain->Brief();
+}
+
+// H.264 builds up a faint small LED over three frames starting with the half-lit one
+// (hard3d-06 drawn with a 0.8 px LED, --seed 34000: the dating series 0.49, 0.70, 0.85 of
+// the step, then whole): dated where the frames cross half lit, by frame 45 itself, not by
+// frame 46, the first past the threshold (a frame late before).
+TEST(LedDetector, ABuildUpFromTheHalfLitFrameIsDatedWhereItCrossesHalfLit) {
+  TinyLedStream stream = FrozenFaintLed({0.98, 0.7, 0.85});
+  const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
+  ASSERT_TRUE(result);
+  const LedPulse& pulse = result->pulses[0];
+  EXPECT_GE(pulse.spread_frames, 2) << result->Brief();
+  EXPECT_EQ(pulse.first_lit_frame, 45) << result->Brief();
+  EXPECT_NEAR(static_cast<double>(pulse.on_ns), *stream.on_s * 1e9, 0.15 * stream.PeriodNs())
+      << result->Brief();
 }
 
 // A build-up the one-step window cannot see (hard3d-06 drawn with --rise-slowdown 3): the
@@ -688,6 +704,41 @@ TEST(LedDetector, WarnsWhenTheLedIsDim) {
     EXPECT_NEAR(static_cast<double>(result->pulses.at(0).on_ns), 0.5e9, 0.5 * stream.PeriodNs());
     ASSERT_EQ(result->warnings.size(), 1u);
     EXPECT_THAT(result->warnings[0], HasSubstr("dim: on-off contrast 14 grey levels"));
+  }
+}
+
+// A dim LED's step (14 levels) switched on half way into frame 30's exposure, that frame
+// shown as the frame `shown_as` (a lossy codec copies or drops a step of a few grey levels
+// whole), the exposure not told: the result's switch-on.
+std::optional<LedPulse> DimStepShownAs(int shown_as) {
+  LedStream stream;
+  stream.on_bgr = cv::Scalar(40, 42, 59);
+  stream.radius_px = 6;
+  stream.on_s = {{0.5, 2.0}};
+  std::vector<Frame> frames = DrawStream(stream);
+  EXPECT_NEAR(LitFraction(stream, frames[30].t_ns), 0.5, 1e-9);
+  frames[static_cast<size_t>(shown_as)]
+      .bgr(stream.LedRoi())
+      .copyTo(frames[30].bgr(stream.LedRoi()));
+  const auto result = Detect(frames, WithRoi(stream.LedRoi()));
+  EXPECT_TRUE(result.ok()) << result.status().ToString();
+  if (!result.ok() || result->pulses.size() != 1) return std::nullopt;
+  return result->pulses[0];
+}
+
+// Both ways (hard3d-06's 0.6 px LED half lit at 2.0 s, drawn with --seed 0 and 1000): the
+// switch-on is dated half way between the last frame shown dark and the first shown lit,
+// half a frame from the truth either way, and its interval holds the truth.
+TEST(LedDetector, ADimStepsHalfLitFrameShownDarkOrLitIsDatedBetweenTheTwo) {
+  const double period_ns = 1e9 / 60.0;
+  for (const int shown_as : {29, 31}) {
+    SCOPED_TRACE(shown_as == 29 ? "shown dark" : "shown lit");
+    const std::optional<LedPulse> pulse = DimStepShownAs(shown_as);
+    ASSERT_TRUE(pulse);
+    const double middle_ns = (shown_as == 29 ? 30.5 : 29.5) * period_ns;
+    EXPECT_NEAR(static_cast<double>(pulse->on_ns), middle_ns, 0.05 * period_ns);
+    EXPECT_LE(std::abs(static_cast<double>(pulse->on_ns) - 0.5e9),
+              static_cast<double>(pulse->on_uncertainty_ns));
   }
 }
 

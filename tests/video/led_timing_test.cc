@@ -155,6 +155,23 @@ TEST(SwitchOnInterval, InconsistentFractionsFallBackToShorterExposures) {
   EXPECT_NEAR(interval.high_ns, 9.2 * kT, 1e-3);
 }
 
+TEST(HalfLitInstant, IsWhereTheLitFractionCrossesOneHalf) {
+  // 20 % at 10 T, 80 % at 11 T: half lit a half of the way between them
+  EXPECT_NEAR(HalfLitInstant(10 * kT, 0.2, 11 * kT, 0.8), 10.5 * kT, 1e-6);
+  // 49 % at 60 T, 70 % at 61 T (a codec's build-up of a 0.8 px LED half lit at 60 T):
+  // close to 60 T, not at the frame that first passed a threshold of one half
+  EXPECT_NEAR(HalfLitInstant(60 * kT, 0.49, 61 * kT, 0.70), (60 + 0.01 / 0.21) * kT, 1e-6);
+  // a frame lit exactly half its exposure is the switch-on
+  EXPECT_NEAR(HalfLitInstant(59 * kT, 0.0, 60 * kT, 0.5), 60 * kT, 1e-6);
+}
+
+TEST(HalfLitInstant, FractionsOutOfOrderGiveTheNearerFrame) {
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.6, 11 * kT, 0.6), 11 * kT);
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.4, 11 * kT, 0.3), 10 * kT);
+  // a fraction beyond 0 .. 1 (noise) stays between the two frames
+  EXPECT_NEAR(HalfLitInstant(10 * kT, -0.5, 11 * kT, 0.25), 11 * kT, 1e-6);
+}
+
 TEST(SwitchOffInterval, IsTheSwitchOnWithTimeReversed) {
   // last lit frame at 10 T lit for its first 30 %, E unknown up to T: s = t - E/2 + 0.3 E
   // = t - 0.2 E: [t - 0.2 T, t]
