@@ -198,10 +198,11 @@ int RunSynth(const SynthCommand& command, std::ostream& out, std::ostream& err) 
        {std::pair{"--rise-slowdown", command.rise_slowdown != 1.0},
         std::pair{"--keyframe-interval", command.keyframe_interval_frames != 0},
         std::pair{"--led-on-spread", command.led_on_spread_s != 0.0},
-        std::pair{"--flicker", command.flicker_amplitude >= 0},
-        std::pair{"--flicker-readout-ms", command.flicker_readout_ms >= 0},
-        std::pair{"--exposure-ms", command.exposure_ms >= 0},
-        std::pair{"--led-radius-mm", command.led_radius_mm >= 0}}) {
+        // (negative: not given; NaN is given, and out of range)
+        std::pair{"--flicker", !(command.flicker_amplitude < 0)},
+        std::pair{"--flicker-readout-ms", !(command.flicker_readout_ms < 0)},
+        std::pair{"--exposure-ms", !(command.exposure_ms < 0)},
+        std::pair{"--led-radius-mm", !(command.led_radius_mm < 0)}}) {
     if (given && !set3d) {
       err << "liftoff synth: " << flag << " works with --set ci3d or hard3d\n";
       return kExitUsage;

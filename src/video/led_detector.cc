@@ -1456,7 +1456,7 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
   // kDimCodecFrac either way (a codec copies or drops a step of a few grey levels whole: a
   // half-lit frame of hard3d-06's 0.6 px LED, 9 levels, is as lit as the next; another,
   // --seed 1000, as dark as the one before)
-  const bool dim = !event.clipped && event.contrast_levels < options.dim_warning_levels;
+  const bool dim = event.contrast_levels < options.dim_warning_levels;
   const double shift = dim ? kDimCodecFrac : band;
   const auto lit_band = [&](double f) {
     return LitFraction{event.clipped ? 0.0 : std::max(0.0, f - shift - event.creep),
@@ -1502,19 +1502,14 @@ LedPulse LedDetector::Impl::DatePulse(const StepEvent& event) const {
       dating.surely = {std::min(dating.surely.low_ns, spread.low_ns),
                        std::max(dating.surely.high_ns, spread.high_ns)};
       // dated where the spread frames cross half lit, not by the first to pass the
-      // threshold (a build-up's frame lit 49 % is the switch-on's own), of the furthest
-      // level the frames after reach (a build-up may still creep on)
-      const double whole_level = *std::max_element(
-          event.value.begin() + static_cast<std::ptrdiff_t>(first_whole), event.value.end());
-      const auto of_whole = [&](size_t i) {
-        return (event.value[i] - event.off) / std::max(whole_level - event.off, scale);
-      };
+      // threshold (a build-up's frame lit 49 % is the switch-on's own)
       size_t above = first_partial;
-      while (above < first_whole && of_whole(above) < 0.5) ++above;
+      while (above < first_whole && fraction(above) < 0.5) ++above;
       dating.estimate_ns = std::clamp(
-          internal::HalfLitInstant(static_cast<double>(event.t_ns[above - 1]), of_whole(above - 1),
-                                   static_cast<double>(event.t_ns[above]), of_whole(above)),
+          internal::HalfLitInstant(static_cast<double>(event.t_ns[above - 1]), fraction(above - 1),
+                                   static_cast<double>(event.t_ns[above]), fraction(above)),
           dating.surely.low_ns, dating.surely.high_ns);
+      dating.missing_frames = 0;  // (the crossing dates it, not a missing frame)
       pulse.first_lit_frame = event.index[first_partial];
       pulse.first_lit_fraction = std::clamp(fraction(first_partial), 0.0, 1.0);
     }

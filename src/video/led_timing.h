@@ -141,11 +141,12 @@ inline SwitchOnDating DateSwitchOn(double t_dark_ns, LitFraction dark, double t_
 // f_above >= 1/2). A frame lit half its exposure is centred on the switch-on whatever the
 // exposure (s = t + E (1/2 - f)), and a blend spreads the step about evenly either side
 // of it, so the crossing does not depend on which of the spread frames first passes a
-// threshold. Fractions outside that order give the nearer frame's timestamp.
+// threshold. Fractions that do not straddle one half give the frame on the half's side: the
+// first when it is lit half or more already, the second when it is still under half.
 inline double HalfLitInstant(double t_below_ns, double f_below, double t_above_ns, double f_above) {
-  if (!(f_above > f_below)) return f_above >= 0.5 ? t_above_ns : t_below_ns;
-  const double along = std::clamp((0.5 - f_below) / (f_above - f_below), 0.0, 1.0);
-  return t_below_ns + along * (t_above_ns - t_below_ns);
+  if (f_below >= 0.5) return t_below_ns;
+  if (!(f_above >= 0.5)) return t_above_ns;
+  return t_below_ns + (0.5 - f_below) / (f_above - f_below) * (t_above_ns - t_below_ns);
 }
 
 // The switch-off instants consistent with frame `lit` (t_lit_ns, lit fraction in

@@ -311,6 +311,8 @@ const std::vector<HostileCase>& Cases() {
        {"hard3d-01", "flicker_readout_s", "0.05"}},
       {"synth --led-radius-mm with a 2D set", nullptr, "synth --set ci --led-radius-mm 2 -o @/set",
        2, {"--led-radius-mm", "ci3d or hard3d"}},
+      {"synth --led-radius-mm nan with a 2D set", nullptr,
+       "synth --set ci --led-radius-mm nan -o @/set", 2, {"--led-radius-mm", "ci3d or hard3d"}},
       {"synth --led-radius-mm under 1 mm", nullptr,
        "synth --set hard3d --led-radius-mm 0.5 -o @/set -q", 3,
        {"--led-radius-mm", "led_radius_m", "0.001 .. 0.02"}},

@@ -527,6 +527,21 @@ TEST(Trial3d, AnLedRadiusVariationSetsEveryClipsLed) {
   }
 }
 
+// hard3d-06's LED is under a pixel: 0.59 px at its own 1.5 mm, 0.79 px at 2 mm, 0.99 px at
+// 2.5 mm (--led-radius-mm).
+TEST(Trial3d, Hard3dTinyLedIsUnderAPixel) {
+  REQUIRE_EGL();
+  Trial3dSpec spec = Hard3dSet()[5];
+  ASSERT_EQ(spec.id, "hard3d-06-side-480p-tiny-led");
+  for (const auto& [radius_m, radius_px] :
+       {std::pair{0.0015, 0.59}, std::pair{0.002, 0.79}, std::pair{0.0025, 0.99}}) {
+    spec.scene.led_radius_m = radius_m;
+    auto renderer = SceneRenderer3d::Create(spec.scene, spec.foot);
+    ASSERT_TRUE(renderer.ok()) << renderer.status().ToString();
+    EXPECT_NEAR((*renderer)->LedRadiusPx(), radius_px, 0.005) << radius_m;
+  }
+}
+
 TEST(Trial3d, LedFractionOfTheCentredExposure) {
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 1.0), 0.5, 1e-12);
   EXPECT_NEAR(LedLitFraction(1.0, 0.02, 0.995), 0.75, 1e-12);

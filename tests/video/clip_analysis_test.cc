@@ -532,15 +532,16 @@ TEST(CliSync, VideoModeAndHandInstantsExcludeEachOtherAndOneIsNeeded) {
 
 // The LED of a lossless crop of a hard3d-06 clip (tests/video/data/README.md): its ROI is
 // 98,12,24,24 and it switches on at 0.8 s.
-void ExpectTinyLedFound(const std::string& clip) {
+void ExpectTinyLedFound(const std::string& clip, double on_s = 0.8, double within_frames = 0.5) {
   ClipAnalysisOptions options;
   options.led.roi_px = cv::Rect(98, 12, 24, 24);
   const auto analysis = AnalyzeClip(SourceDir() / "tests" / "video" / "data" / clip, options);
   ASSERT_TRUE(analysis.ok()) << clip << ": " << analysis.status().ToString();
   ASSERT_EQ(analysis->led.pulses.size(), 1u) << clip << ": " << analysis->led.Brief();
   const LedPulse& pulse = analysis->led.pulses.front();
-  const double error_ns = static_cast<double>(pulse.on_ns) - 0.8e9;
-  EXPECT_LE(std::abs(error_ns), 0.5e9 / 30.0) << clip << ": " << analysis->led.Brief();
+  const double error_ns = static_cast<double>(pulse.on_ns) - on_s * 1e9;
+  EXPECT_LE(std::abs(error_ns), within_frames * 1e9 / 30.0)
+      << clip << ": " << analysis->led.Brief();
   EXPECT_LE(std::abs(error_ns), static_cast<double>(pulse.on_uncertainty_ns))
       << clip << ": " << analysis->led.Brief();
 }
@@ -559,6 +560,19 @@ TEST(ClipAnalysis, ATinyLedACodecBuildsUpIsFoundOnItsRealPixels) {
 // either way, one 4 px from the LED by a third of its step.
 TEST(ClipAnalysis, ATinyLedInABlockTheCodecRenewedIsFoundOnItsRealPixels) {
   ExpectTinyLedFound("hard3d-06-seed5000-led.mkv");
+}
+
+// A 0.79 px LED (--led-radius-mm 2) that H.264 built up from its half-lit frame over three
+// frames: dated where the frames cross half lit, +0.197 frame here (+0.908 by the first frame
+// past one half, as before).
+TEST(ClipAnalysis, ASmallLedBuiltUpFromItsHalfLitFrameIsDatedWhereItCrossesHalfLit) {
+  ExpectTinyLedFound("hard3d-06-r2mm-seed34000-led.mkv", 0.8, 0.25);
+}
+
+// A 0.6 px LED that H.264's B-frames blended over two frames (0.29 and 0.68 of the step in
+// its brightest pixel, the first 0.53 lit): +0.382 frame here (+1.105 before).
+TEST(ClipAnalysis, ATinyLedBlendedOverBFramesIsDatedWhereItCrossesHalfLit) {
+  ExpectTinyLedFound("hard3d-06-seed20000-led.mkv", 2.9328037921144423 - 64 / 30.0);
 }
 
 }  // namespace liftoff::video

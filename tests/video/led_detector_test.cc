@@ -547,21 +547,6 @@ TEST(LedDetector, AStepACodecBlendsOverTwoFramesWidensItsIntervalOverBoth) {
   EXPECT_LE(plain->pulses[0].spread_frames, 1) << plain->Brief();
 }
 
-// H.264 builds up a faint small LED over three frames starting with the half-lit one
-// (hard3d-06 drawn with a 0.8 px LED, --seed 34000: the dating series 0.49, 0.70, 0.85 of
-// the step, then whole): dated where the frames cross half lit, by frame 45 itself, not by
-// frame 46, the first past the threshold (a frame late before).
-TEST(LedDetector, ABuildUpFromTheHalfLitFrameIsDatedWhereItCrossesHalfLit) {
-  TinyLedStream stream = FrozenFaintLed({0.98, 0.7, 0.85});
-  const std::optional<LedResult> result = DetectOnePulseAroundTheTruth(stream);
-  ASSERT_TRUE(result);
-  const LedPulse& pulse = result->pulses[0];
-  EXPECT_GE(pulse.spread_frames, 2) << result->Brief();
-  EXPECT_EQ(pulse.first_lit_frame, 45) << result->Brief();
-  EXPECT_NEAR(static_cast<double>(pulse.on_ns), *stream.on_s * 1e9, 0.15 * stream.PeriodNs())
-      << result->Brief();
-}
-
 // A build-up the one-step window cannot see (hard3d-06 drawn with --rise-slowdown 3): the
 // detector dates the first frame that changed, lit for an unknown part of its exposure, and
 // says so.
@@ -710,9 +695,13 @@ TEST(LedDetector, WarnsWhenTheLedIsDim) {
 // A dim LED's step (14 levels) switched on half way into frame 30's exposure, that frame
 // shown as the frame `shown_as` (a lossy codec copies or drops a step of a few grey levels
 // whole), the exposure not told: the result's switch-on.
-std::optional<LedPulse> DimStepShownAs(int shown_as) {
+std::optional<LedPulse> DimStepShownAs(int shown_as, bool clipped) {
   LedStream stream;
   stream.on_bgr = cv::Scalar(40, 42, 59);
+  if (clipped) {  // the lit LED at 255 in its brightest channel
+    stream.off_bgr = cv::Scalar(230, 232, 241);
+    stream.on_bgr = cv::Scalar(230, 232, 255);
+  }
   stream.radius_px = 6;
   stream.on_s = {{0.5, 2.0}};
   std::vector<Frame> frames = DrawStream(stream);
@@ -720,32 +709,43 @@ std::optional<LedPulse> DimStepShownAs(int shown_as) {
   frames[static_cast<size_t>(shown_as)]
       .bgr(stream.LedRoi())
       .copyTo(frames[30].bgr(stream.LedRoi()));
-  const auto result = Detect(frames, WithRoi(stream.LedRoi()));
+  const auto result = Detect(frames, WithRoi(stream.LedRoi(), clipped ? stream.exposure_s : 0.0));
   EXPECT_TRUE(result.ok()) << result.status().ToString();
   if (!result.ok() || result->pulses.size() != 1) return std::nullopt;
   return result->pulses[0];
 }
 
-// Both ways (hard3d-06's 0.6 px LED half lit at 2.0 s, drawn with --seed 0 and 1000): the
+// Both ways (hard3d-06's 0.6 px LED half lit at 2.0 s: --seed 0, and --seed 1000
+// --keyframe-interval 250 --rise-slowdown 3): the
 // switch-on is dated half way between the last frame shown dark and the first shown lit,
-// half a frame from the truth either way, and its interval holds the truth.
+// half a frame from the truth either way, and its interval holds the truth. When the lit
+// LED clips its first lit frame may have been lit for any part of its exposure (a clipped
+// core looks lit whole), so the estimate is later, but with the exposure told the interval
+// still holds the truth (before, with the last dark frame lit at most 0.15, it did not).
 TEST(LedDetector, ADimStepsHalfLitFrameShownDarkOrLitIsDatedBetweenTheTwo) {
   const double period_ns = 1e9 / 60.0;
-  for (const int shown_as : {29, 31}) {
-    SCOPED_TRACE(shown_as == 29 ? "shown dark" : "shown lit");
-    const std::optional<LedPulse> pulse = DimStepShownAs(shown_as);
-    ASSERT_TRUE(pulse);
-    const double middle_ns = (shown_as == 29 ? 30.5 : 29.5) * period_ns;
-    EXPECT_NEAR(static_cast<double>(pulse->on_ns), middle_ns, 0.05 * period_ns);
-    EXPECT_LE(std::abs(static_cast<double>(pulse->on_ns) - 0.5e9),
-              static_cast<double>(pulse->on_uncertainty_ns));
+  for (const bool clipped : {false, true}) {
+    for (const int shown_as : {29, 31}) {
+      SCOPED_TRACE(std::string(shown_as == 29 ? "shown dark" : "shown lit") +
+                   (clipped ? ", clipped" : ""));
+      const std::optional<LedPulse> pulse = DimStepShownAs(shown_as, clipped);
+      ASSERT_TRUE(pulse);
+      const double middle_ns = (shown_as == 29 ? 30.5 : 29.5) * period_ns;
+      if (!clipped) {
+        EXPECT_NEAR(static_cast<double>(pulse->on_ns), middle_ns, 0.05 * period_ns);
+      }
+      EXPECT_LE(std::abs(static_cast<double>(pulse->on_ns) - 0.5e9),
+                static_cast<double>(pulse->on_uncertainty_ns) + 1e3);
+    }
   }
 }
 
 TEST(LedDetector, ADimLedsPartlyLitFrameShownFullyLitStillHoldsTheTruth) {
   // a 14-level step half lit in frame 30 (0.5 s mid-exposure), but shown as lit as the
-  // next frame, as a lossy codec copies a step of a few grey levels whole (hard3d-06): the
-  // frame's fraction cannot be trusted, only that it was lit at most fully
+  // next frame, as a lossy codec copies a step of a few grey levels whole (hard3d-06), the
+  // exposure told: each frame's fraction is known to within half the step either way, so
+  // the switch-on is dated half way between frames 29 and 30, the truth at the interval's
+  // end (before, only the upper bound was widened: 0.29 frame early)
   LedStream stream;
   stream.on_bgr = cv::Scalar(40, 42, 59);
   stream.radius_px = 6;
@@ -758,8 +758,8 @@ TEST(LedDetector, ADimLedsPartlyLitFrameShownFullyLitStillHoldsTheTruth) {
   const LedPulse& pulse = result->pulses.at(0);
   EXPECT_EQ(pulse.first_lit_frame, 30);
   EXPECT_LE(std::abs(static_cast<double>(pulse.on_ns) - 0.5e9),
-            static_cast<double>(pulse.on_uncertainty_ns));
-  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 0.5e9, 0.5 * stream.PeriodNs());
+            static_cast<double>(pulse.on_uncertainty_ns) + 1e3);
+  EXPECT_NEAR(static_cast<double>(pulse.on_ns), 29.5 * stream.PeriodNs(), 0.05 * stream.PeriodNs());
 }
 
 TEST(LedDetector, FindsAnLedOnABrightBoard) {

@@ -165,11 +165,18 @@ TEST(HalfLitInstant, IsWhereTheLitFractionCrossesOneHalf) {
   EXPECT_NEAR(HalfLitInstant(59 * kT, 0.0, 60 * kT, 0.5), 60 * kT, 1e-6);
 }
 
-TEST(HalfLitInstant, FractionsOutOfOrderGiveTheNearerFrame) {
-  EXPECT_EQ(HalfLitInstant(10 * kT, 0.6, 11 * kT, 0.6), 11 * kT);
-  EXPECT_EQ(HalfLitInstant(10 * kT, 0.4, 11 * kT, 0.3), 10 * kT);
-  // a fraction beyond 0 .. 1 (noise) stays between the two frames
-  EXPECT_NEAR(HalfLitInstant(10 * kT, -0.5, 11 * kT, 0.25), 11 * kT, 1e-6);
+TEST(HalfLitInstant, FractionsNotStraddlingOneHalfGiveTheFrameOnItsSide) {
+  // the first frame lit half or more already: it (continuous with a crossing at it)
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.6, 11 * kT, 0.6), 10 * kT);
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.6, 11 * kT, 0.6000001), 10 * kT);
+  EXPECT_NEAR(HalfLitInstant(10 * kT, 0.4999999, 11 * kT, 0.6), 10 * kT, 1e-3 * kT);
+  // the second still under half: it
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.3, 11 * kT, 0.3), 11 * kT);
+  EXPECT_EQ(HalfLitInstant(10 * kT, 0.4, 11 * kT, 0.3), 11 * kT);
+  EXPECT_NEAR(HalfLitInstant(10 * kT, 0.3, 11 * kT, 0.5), 11 * kT, 1e-6);
+  // fractions beyond 0 .. 1 (noise) stay between the two frames
+  EXPECT_NEAR(HalfLitInstant(10 * kT, -0.5, 11 * kT, 1.5), 10.5 * kT, 1e-6);
+  EXPECT_NEAR(HalfLitInstant(10 * kT, 0.0, 11 * kT, 2.0), 10.25 * kT, 1e-6);
 }
 
 TEST(SwitchOffInterval, IsTheSwitchOnWithTimeReversed) {
