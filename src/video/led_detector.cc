@@ -274,6 +274,12 @@ struct StepEvent {
   float level_step_before = 0.0f;
 };
 
+// Whether `event` is a rise of the LED's own light (kRoiOwnLight) whose step came after
+// t_ns (its last frame before the step is later).
+bool OwnRiseAfter(const StepEvent& event, int64_t t_ns) {
+  return event.region == kRoiOwnLight && event.rise && event.t_ns[kBeforeFrames - 1] > t_ns;
+}
+
 }  // namespace
 
 Status LedDetector::Options::Validate() const {
@@ -1178,17 +1184,14 @@ bool LedDetector::Impl::RiseMayStartAt(int64_t first, double step) const {
     return true;
   }
   const int64_t first_t_ns = ring_t_ns[Slot(first)];
-  return std::any_of(pending.begin(), pending.end(), [&](const StepEvent& event) {
-    return event.region == kRoiOwnLight && event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
-  });
+  return std::any_of(pending.begin(), pending.end(),
+                     [&](const StepEvent& event) { return OwnRiseAfter(event, first_t_ns); });
 }
 
 void LedDetector::Impl::DropRisesAfter(int64_t first) {
   const int64_t first_t_ns = ring_t_ns[Slot(first)];
   const StepEvent* earliest = nullptr;
-  const auto later_rise = [&](const StepEvent& event) {
-    return event.region == kRoiOwnLight && event.rise && event.t_ns[kBeforeFrames - 1] > first_t_ns;
-  };
+  const auto later_rise = [&](const StepEvent& event) { return OwnRiseAfter(event, first_t_ns); };
   for (const StepEvent& event : pending) {
     if (later_rise(event) &&
         (!earliest || event.t_ns[kBeforeFrames] < earliest->t_ns[kBeforeFrames])) {
